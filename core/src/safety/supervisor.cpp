@@ -1,0 +1,237 @@
+#include "core/safety/supervisor.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+namespace core {
+namespace {
+
+bool stale(Nanos stamp, Nanos now, Nanos timeout) {
+  return stamp == kNever || now - stamp > timeout;
+}
+
+double age_ms(Nanos stamp, Nanos now) {
+  return stamp == kNever ? std::numeric_limits<double>::infinity() : to_ms(now - stamp);
+}
+
+const char* confidence_name(TrackerConfidence c) {
+  switch (c) {
+    case TrackerConfidence::kGood: return "GOOD";
+    case TrackerConfidence::kDegraded: return "DEGRADED";
+    case TrackerConfidence::kBad: return "BAD";
+    case TrackerConfidence::kUnknown: break;
+  }
+  return "UNKNOWN";
+}
+
+}  // namespace
+
+Supervisor::Supervisor(const SupervisorConfig& config) : config_(config) {
+  for (size_t i = 0; i < kReasonCount; ++i) {
+    const Reason r = kReasonTable[i].reason;
+    // Faults latch in the state machine; their debounce only needs to see the cause gone.
+    Nanos clear = config_.resume_after;
+    if (r == Reason::kTrackerConfidenceLow) clear = config_.tracker_confidence_recover;
+    if (kReasonTable[i].severity != Severity::kHold || r == Reason::kStarting) clear = Nanos(0);
+    debounce_[i].set_clear_after(clear);
+  }
+}
+
+ReasonSet Supervisor::evaluate(const SafetyInputs& in, Nanos now) {
+  std::array<bool, kReasonCount> raw{};
+  auto set = [&](Reason r, bool v) { raw[reason_index(r)] = v; };
+
+  set(Reason::kShutdown, in.shutdown);
+  set(Reason::kStarting, !in.initialized);
+  set(Reason::kOperatorStop, in.operator_stop);
+
+  if (config_.require_tracker) {
+    const bool silent = stale(in.tracker_stamp, now, config_.tracker_timeout);
+    set(Reason::kTrackerSilent, silent);
+    // Confidence only means something for fresh data; silence is its own reason.
+    set(Reason::kTrackerConfidenceLow,
+        !silent && (in.tracker_confidence == TrackerConfidence::kBad ||
+                    in.tracker_confidence == TrackerConfidence::kUnknown));
+    set(Reason::kPersonLost, !silent && std::isfinite(in.person_distance_m) &&
+                                 in.person_distance_m > config_.person_max_distance_m);
+  }
+  if (config_.require_lidar) {
+    const bool silent = stale(in.lidar_stamp, now, config_.lidar_timeout);
+    set(Reason::kLidarSilent, silent);
+    set(Reason::kCostmapStale, !silent && stale(in.costmap_stamp, now, config_.costmap_max_age));
+  }
+  if (config_.require_base) {
+    const bool silent = stale(in.base_feedback_stamp, now, config_.base_feedback_timeout);
+    set(Reason::kBaseFeedbackSilent, silent);
+    set(Reason::kBaseFault, in.base_fault_word != 0);
+    set(Reason::kBaseEstop, in.base_estop);
+    set(Reason::kRcOverride, in.rc_override);
+    set(Reason::kCanBusOff, in.can_bus_off);
+  }
+
+  // Counters: a new error since the previous update trips the condition (cleared by hysteresis).
+  if (counters_seen_) {
+    if (config_.require_base) set(Reason::kCanWriteErrors, in.can_write_errors > last_write_errors_);
+    set(Reason::kControlOverrun, in.control_overruns > last_overruns_);
+  }
+  counters_seen_ = true;
+  last_write_errors_ = in.can_write_errors;
+  last_overruns_ = in.control_overruns;
+
+  set(Reason::kControlStalled,
+      in.initialized && stale(in.control_heartbeat, now, config_.control_stall_timeout));
+  set(Reason::kNumericalFailure, in.numerical_failure);
+
+  ReasonSet active;
+  for (size_t i = 0; i < kReasonCount; ++i) active[i] = debounce_[i].update(raw[i], now);
+  return active;
+}
+
+Reason Supervisor::primary(const ReasonSet& set, Severity min_severity) {
+  for (size_t i = 0; i < kReasonCount; ++i) {
+    if (set[i] && kReasonTable[i].severity >= min_severity) return kReasonTable[i].reason;
+  }
+  return Reason::kNone;
+}
+
+void Supervisor::describe(const SafetyInputs& in, Nanos now, Reason r,
+                          std::array<char, 200>& out) const {
+  char* buf = out.data();
+  const size_t n = out.size();
+  switch (r) {
+    case Reason::kTrackerSilent:
+      std::snprintf(buf, n, "tracker age %.1f ms > timeout %.1f ms",
+                    age_ms(in.tracker_stamp, now), to_ms(config_.tracker_timeout));
+      break;
+    case Reason::kTrackerConfidenceLow:
+      std::snprintf(buf, n, "tracker confidence %s, age %.1f ms",
+                    confidence_name(in.tracker_confidence), age_ms(in.tracker_stamp, now));
+      break;
+    case Reason::kPersonLost:
+      std::snprintf(buf, n, "person distance %.2f m > %.2f m", in.person_distance_m,
+                    config_.person_max_distance_m);
+      break;
+    case Reason::kLidarSilent:
+      std::snprintf(buf, n, "lidar age %.1f ms > timeout %.1f ms", age_ms(in.lidar_stamp, now),
+                    to_ms(config_.lidar_timeout));
+      break;
+    case Reason::kCostmapStale:
+      std::snprintf(buf, n, "costmap age %.1f ms > max %.1f ms", age_ms(in.costmap_stamp, now),
+                    to_ms(config_.costmap_max_age));
+      break;
+    case Reason::kBaseFeedbackSilent:
+      std::snprintf(buf, n, "base feedback age %.1f ms > timeout %.1f ms",
+                    age_ms(in.base_feedback_stamp, now), to_ms(config_.base_feedback_timeout));
+      break;
+    case Reason::kBaseFault:
+      std::snprintf(buf, n, "base fault word 0x%04x", in.base_fault_word);
+      break;
+    case Reason::kCanWriteErrors:
+      std::snprintf(buf, n, "CAN write errors %llu",
+                    static_cast<unsigned long long>(in.can_write_errors));
+      break;
+    case Reason::kControlOverrun:
+      std::snprintf(buf, n, "control overruns %llu",
+                    static_cast<unsigned long long>(in.control_overruns));
+      break;
+    case Reason::kControlStalled:
+      std::snprintf(buf, n, "control heartbeat age %.1f ms > %.1f ms",
+                    age_ms(in.control_heartbeat, now), to_ms(config_.control_stall_timeout));
+      break;
+    default:
+      std::snprintf(buf, n, "%.*s", static_cast<int>(reason_text(r).size()),
+                    reason_text(r).data());
+      break;
+  }
+}
+
+SupervisorOutput Supervisor::update(const SafetyInputs& in, Nanos now) {
+  const ReasonSet active = evaluate(in, now);
+  const SafetyState prev_state = state_;
+  const Reason prev_reason = reason_;
+
+  const Reason terminal = primary(active, Severity::kTerminal);
+  const Reason fault = primary(active, Severity::kFault);
+  const Reason hold = primary(active, Severity::kHold);
+
+  if (terminal != Reason::kNone) {
+    state_ = SafetyState::kHold;
+    reason_ = terminal;
+  } else if (state_ == SafetyState::kFault) {
+    // Latched: only request_fault_clear() leaves FAULT.
+  } else if (fault != Reason::kNone) {
+    state_ = SafetyState::kFault;
+    reason_ = fault;
+  } else {
+    switch (state_) {
+      case SafetyState::kInit:
+        if (in.initialized) {
+          state_ = SafetyState::kArming;
+          reason_ = Reason::kNone;
+          all_clear_since_ = kNever;
+        }
+        break;
+      case SafetyState::kArming:
+        if (hold != Reason::kNone) {
+          state_ = SafetyState::kHold;
+          reason_ = hold;
+        } else {
+          if (all_clear_since_ == kNever) all_clear_since_ = now;
+          if (now - all_clear_since_ >= config_.arming_time) {
+            state_ = SafetyState::kActive;
+            reason_ = Reason::kNone;
+          }
+        }
+        break;
+      case SafetyState::kActive:
+        if (hold != Reason::kNone) {
+          state_ = SafetyState::kHold;
+          reason_ = hold;
+        }
+        break;
+      case SafetyState::kHold:
+        // Each cause already waited `resume_after` clear in its debounce.
+        if (hold == Reason::kNone) {
+          state_ = SafetyState::kActive;
+          reason_ = Reason::kNone;
+        } else {
+          reason_ = hold;
+        }
+        break;
+      case SafetyState::kFault:
+        break;
+    }
+  }
+
+  SupervisorOutput out;
+  out.state = state_;
+  out.reason = reason_;
+  out.active = active;
+  out.motion_allowed = state_ == SafetyState::kActive;
+  out.watchdog_ok = in.initialized && !stale(in.control_heartbeat, now, config_.control_stall_timeout);
+  if (state_ != prev_state || reason_ != prev_reason) {
+    out.transitioned = true;
+    out.transition.from = prev_state;
+    out.transition.to = state_;
+    out.transition.reason = reason_;
+    if (reason_ != Reason::kNone) {
+      describe(in, now, reason_, out.transition.values);
+    } else {
+      std::snprintf(out.transition.values.data(), out.transition.values.size(), "%s",
+                    state_ == SafetyState::kArming ? "checking inputs" : "all inputs healthy");
+    }
+  }
+  return out;
+}
+
+bool Supervisor::request_fault_clear(const SafetyInputs& in, Nanos now) {
+  if (state_ != SafetyState::kFault) return false;
+  const ReasonSet active = evaluate(in, now);
+  if (primary(active, Severity::kFault) != Reason::kNone) return false;
+  state_ = SafetyState::kArming;
+  reason_ = Reason::kNone;
+  all_clear_since_ = kNever;
+  return true;
+}
+
+}  // namespace core

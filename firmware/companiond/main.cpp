@@ -1,0 +1,176 @@
+// companiond: the companion robot daemon. Loads and validates the configuration, sets up
+// real-time scheduling, runs the task table until SIGTERM/SIGINT, then stops the robot before
+// exiting. See README.md ("Deploy on the robot", "Diagnose").
+#include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
+
+#include <csignal>
+#include <cstdio>
+#include <iostream>
+
+#include "firmware/config/config_loader.hpp"
+#include "firmware/daemon.hpp"
+#include "firmware/logging.hpp"
+#include "firmware/task_table.hpp"
+#include "hal/linux_clock.hpp"
+#include "hal/realtime.hpp"
+#include "hal/sd_notify.hpp"
+
+namespace {
+
+int print_errors(const std::vector<firmware::ConfigError>& errors) {
+  for (const auto& e : errors) std::cerr << "config error: " << e.to_string() << "\n";
+  return 2;
+}
+
+// Waits up to `timeout` for SIGINT/SIGTERM (blocked in every thread); returns the signal or 0.
+int wait_signal(const sigset_t& set, std::chrono::milliseconds timeout) {
+  timespec ts{};
+  ts.tv_sec = static_cast<time_t>(timeout.count() / 1000);
+  ts.tv_nsec = static_cast<long>((timeout.count() % 1000) * 1'000'000);
+  const int sig = sigtimedwait(&set, nullptr, &ts);
+  return sig > 0 ? sig : 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"companiond - companion robot daemon (Amfitrack + VLP-16 + Scout Mini)"};
+  std::string config_path;
+  std::string check_path;
+  bool print = false;
+  bool reference = false;
+  double duration_s = 0.0;
+  std::string sink_name = "auto";
+  app.add_option("-c,--config", config_path, "YAML configuration (keys: config/README.md)");
+  app.add_option("--check-config", check_path, "validate FILE, print the verdict and exit");
+  app.add_flag("--print-config", print, "print the effective configuration and exit");
+  app.add_flag("--config-reference", reference, "print the Markdown reference of every key");
+  app.add_option("--duration-s", duration_s, "stop by itself after this many seconds (0: run)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--log-sink", sink_name, "auto (journald under systemd), console, journald")
+      ->check(CLI::IsMember({"auto", "console", "journald"}));
+  CLI11_PARSE(app, argc, argv);
+
+  if (reference) {
+    std::cout << firmware::config_reference_markdown();
+    return 0;
+  }
+  if (!check_path.empty()) {
+    const auto r = firmware::load_config_file(check_path);
+    if (!r.ok()) return print_errors(r.errors);
+    std::cout << check_path << ": OK\n";
+    return 0;
+  }
+  const auto loaded = config_path.empty() ? firmware::load_default_config()
+                                          : firmware::load_config_file(config_path);
+  if (!loaded.ok()) return print_errors(loaded.errors);
+  const firmware::DaemonConfig& cfg = *loaded.config;
+  if (print) {
+    std::cout << firmware::print_config(cfg);
+    return 0;
+  }
+
+  const auto sink = sink_name == "console"    ? firmware::LogSink::kConsole
+                    : sink_name == "journald" ? firmware::LogSink::kJournald
+                                              : firmware::LogSink::kAuto;
+  firmware::setup_logging(cfg.logging.level, sink);
+  spdlog::info("companiond starting (config: {})",
+               config_path.empty() ? std::string("built-in defaults") : config_path);
+  for (const auto& row : firmware::task_table()) {
+    spdlog::info("task {:<10} {:>4} Hz budget {:>5} us group {} prio {}{}", row.spec.name,
+                 row.spec.rate_hz, row.spec.budget_us,
+                 firmware::group_table()[row.spec.group].name, row.spec.priority,
+                 row.pending.empty() ? std::string()
+                                     : " - not yet implemented: " + std::string(row.pending));
+  }
+  spdlog::info("devices: tracker '{}', lidar '{}', base '{}'", cfg.devices.tracker,
+               cfg.devices.lidar, cfg.devices.base);
+
+  hal::RtResult mem{true, 0, "not requested"};
+  if (cfg.realtime.enable) {
+    mem = hal::lock_process_memory();
+    if (!mem.ok && cfg.realtime.require) {
+      spdlog::critical("realtime.require is set but {}", mem.message);
+      firmware::shutdown_logging();
+      return 1;
+    }
+  }
+
+  // SIGINT/SIGTERM are taken synchronously by this thread only (blocked in every thread).
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+
+  hal::SystemdNotifier notifier;
+  hal::LinuxClock clock;
+  firmware::Daemon daemon(cfg, notifier);
+  firmware::Executor executor(clock, firmware::group_table(), daemon.bindings());
+  daemon.attach(executor);
+  executor.start(clock.now() + std::chrono::milliseconds(10), cfg.realtime.enable);
+
+  if (cfg.realtime.enable) {
+    std::string failed;
+    std::string why;
+    for (const auto& o : executor.rt_outcomes()) {
+      if (!o.ok) {
+        failed += (failed.empty() ? "" : ", ") + o.group;
+        why = o.message;
+      }
+    }
+    if (!failed.empty() || !mem.ok) {
+      if (cfg.realtime.require) {
+        spdlog::critical("realtime.require is set but real-time scheduling is not permitted "
+                         "(groups: {}): {}",
+                         failed, why);
+        executor.stop();
+        firmware::shutdown_logging();
+        return 1;
+      }
+      spdlog::warn("running WITHOUT real-time guarantees: {}{} - deadlines may be missed under "
+                   "load (grant CAP_SYS_NICE and CAP_IPC_LOCK, as the systemd unit does)",
+                   failed.empty() ? "" : "SCHED_FIFO refused for " + failed + ": " + why,
+                   mem.ok ? "" : (failed.empty() ? "" : "; ") + mem.message);
+    } else {
+      spdlog::info("real-time: memory locked, SCHED_FIFO rate-group threads");
+    }
+  }
+
+  daemon.mark_initialized();
+  notifier.ready_with_status("started: waiting for inputs");
+  spdlog::info("running; stop with Ctrl-C or SIGTERM");
+
+  const auto started = clock.now();
+  bool stopping = false;
+  core::Nanos stop_deadline{0};
+  for (;;) {
+    const int sig = wait_signal(signals, std::chrono::milliseconds(50));
+    const auto now = clock.now();
+    const bool timed_out = duration_s > 0 && core::to_seconds(now - started) >= duration_s;
+    if ((sig != 0 || timed_out) && !stopping) {
+      spdlog::info("{}: stopping the robot, then exiting",
+                   sig != 0 ? (sig == SIGTERM ? "SIGTERM" : "SIGINT") : "--duration-s reached");
+      notifier.stopping();
+      daemon.request_shutdown();
+      stopping = true;
+      stop_deadline = now + core::from_ms(cfg.supervisor.stop_max_time_ms) + core::from_ms(500);
+    } else if (sig != 0 && stopping) {
+      spdlog::warn("second signal: exiting now");
+      break;
+    }
+    if (stopping && daemon.shutdown_complete()) {
+      spdlog::info("zero velocity commanded; exiting");
+      break;
+    }
+    if (stopping && now > stop_deadline) {
+      spdlog::error("controlled stop did not complete in time; exiting anyway");
+      break;
+    }
+  }
+  executor.stop();
+  spdlog::info("final timing: {}", daemon.timing_summary());
+  firmware::shutdown_logging();
+  return 0;
+}

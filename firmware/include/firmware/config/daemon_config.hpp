@@ -1,0 +1,83 @@
+#pragma once
+// Typed configuration of companiond. Every field is listed, with its key, unit, range and
+// meaning, in the schema (src/config/schema.cpp); defaults live in config/companiond.yaml.
+#include <cstdint>
+#include <string>
+
+namespace firmware {
+
+struct DaemonConfig {
+  struct Devices {
+    std::string tracker;  // hid:auto | hid:<hidraw path or serial> | serial:<port>[@baud] | sim | none
+    std::string lidar;    // udp:<bind addr>:<port> | sim | none
+    std::string base;     // socketcan:<ifname> | slcan:<tty> | virtual:<bus> | sim | none
+  } devices;
+
+  struct Realtime {
+    bool enable = true;    // try mlockall + SCHED_FIFO threads
+    bool require = false;  // refuse to start if not permitted
+  } realtime;
+
+  struct Logging {
+    std::string level;
+    double summary_period_s = 0;
+    int64_t warning_interval_ms = 0;
+  } logging;
+
+  struct Supervisor {
+    int64_t arming_time_ms = 0;
+    int64_t resume_after_ms = 0;
+    int64_t tracker_timeout_ms = 0;
+    int64_t tracker_confidence_recover_ms = 0;
+    double person_max_distance_m = 0;
+    int64_t lidar_timeout_ms = 0;
+    int64_t costmap_max_age_ms = 0;
+    int64_t base_feedback_timeout_ms = 0;
+    int64_t control_stall_timeout_ms = 0;
+    double stop_linear_decel_mps2 = 0;
+    double stop_angular_decel_radps2 = 0;
+    int64_t stop_max_time_ms = 0;
+  } supervisor;
+
+  struct Limits {
+    double vx_max_mps = 0;
+    double vy_max_mps = 0;
+    double wz_max_radps = 0;
+    double linear_accel_max_mps2 = 0;
+    double angular_accel_max_radps2 = 0;
+  } limits;
+
+  struct InteractiveSpace {
+    int64_t points = 0;
+    double ellipse_a_m = 0;
+    double ellipse_b_m = 0;
+    double cost_threshold = 0;
+  } interactive_space;
+
+  struct Objective {
+    double alpha = 0;
+    double beta = 0;
+    double gamma = 0;
+  } objective;
+
+  struct Mppi {
+    int64_t horizon_steps = 0;
+    double step_s = 0;
+    int64_t samples = 0;
+    double lambda = 0;
+    double q_x = 0;
+    double q_y = 0;
+    double q_theta = 0;
+    double collision_cost = 0;
+    double noise_vx_mps = 0;
+    double noise_vy_mps = 0;
+    double noise_wz_radps = 0;
+  } mppi;
+
+  struct Dcbf {
+    double delta = 0;
+    double c_safe = 0;
+  } dcbf;
+};
+
+}  // namespace firmware

@@ -1,0 +1,95 @@
+#pragma once
+// companiond's components and its task functions (bound to the task table). Tasks receive time
+// through core::Tick and exchange data only through latest-value channels.
+#include <atomic>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/channel/latest_value.hpp"
+#include "core/safety/motion_gate.hpp"
+#include "core/safety/supervisor.hpp"
+#include "firmware/config/daemon_config.hpp"
+#include "firmware/logging.hpp"
+#include "firmware/scheduler/executor.hpp"
+#include "hal/sd_notify.hpp"
+
+namespace firmware {
+
+// What the supervisor task publishes for the others.
+struct SafetySnapshot {
+  core::SafetyState state = core::SafetyState::kInit;
+  core::Reason reason = core::Reason::kStarting;
+  bool motion_allowed = false;
+  uint32_t active_mask = 0;  // bit i = kReasonTable[i] present
+};
+static_assert(core::kReasonCount <= 32, "active_mask holds one bit per reason");
+
+core::SupervisorConfig supervisor_config(const DaemonConfig& cfg);
+core::StopLimits stop_limits(const DaemonConfig& cfg);
+
+class Daemon {
+ public:
+  Daemon(const DaemonConfig& cfg, hal::SystemdNotifier& notifier);
+
+  // The task table bound to this daemon, for an Executor.
+  std::vector<TaskBinding> bindings();
+  // The executor running the bindings (the supervisor and the report read its statistics).
+  void attach(const Executor& executor) { executor_ = &executor; }
+
+  // Start-up finished: devices open, tasks running (the supervisor leaves INIT).
+  void mark_initialized() { initialized_.store(true, std::memory_order_release); }
+  // SIGTERM/SIGINT: hold and stop the robot; shutdown_complete() tells when it is safe to exit.
+  void request_shutdown() { shutdown_.store(true, std::memory_order_release); }
+  [[nodiscard]] bool shutdown_complete() const;
+
+  // The task functions (see task_table.cpp).
+  void tracker_task(const core::Tick& tick);
+  void base_task(const core::Tick& tick);
+  void lidar_task(const core::Tick& tick);
+  void policy_task(const core::Tick& tick);
+  void control_task(const core::Tick& tick);
+  void supervisor_task(const core::Tick& tick);
+  void report_task(const core::Tick& tick);
+
+  // Channels (read side), for tools and tests.
+  [[nodiscard]] const core::LatestValue<SafetySnapshot>& safety() const { return safety_; }
+  [[nodiscard]] const core::LatestValue<core::BodyVelocity>& command() const { return command_; }
+
+  // One line: "HOLD: tracker silent (+2: ...) | tracker 120.0Hz ... | shells: ...".
+  // Built by the report task; rates are measured over its last period.
+  [[nodiscard]] std::string status_line() const;
+  // Per-task timing summary (rate, jitter p50/p99/max, run time p99/max, overruns, skips).
+  [[nodiscard]] std::string timing_summary() const;
+
+ private:
+  std::string safety_text(const SafetySnapshot& s) const;
+
+  DaemonConfig cfg_;
+  hal::SystemdNotifier& notifier_;
+  const Executor* executor_ = nullptr;
+
+  std::atomic<bool> initialized_{false};
+  std::atomic<bool> shutdown_{false};
+
+  // supervisor task state
+  core::Supervisor supervisor_;
+  core::Nanos initialized_at_ = core::kNever;
+  core::Nanos last_watchdog_ping_ = core::kNever;
+  std::optional<std::chrono::microseconds> watchdog_interval_;
+  core::LatestValue<SafetySnapshot> safety_;
+
+  // control task state
+  core::MotionGate gate_;
+  core::LatestValue<core::BodyVelocity> command_;
+
+  // report task state
+  std::vector<uint64_t> last_runs_;
+  core::Nanos last_report_ = core::kNever;
+  core::Nanos last_summary_ = core::kNever;
+  std::vector<double> measured_rate_hz_;
+  std::string status_;
+  std::string last_status_sent_;
+};
+
+}  // namespace firmware

@@ -1,0 +1,211 @@
+#include "firmware/daemon.hpp"
+
+#include <fmt/format.h>
+
+#include "firmware/task_table.hpp"
+
+namespace firmware {
+
+using core::Nanos;
+
+core::SupervisorConfig supervisor_config(const DaemonConfig& cfg) {
+  const auto& s = cfg.supervisor;
+  core::SupervisorConfig c;
+  c.arming_time = core::from_ms(s.arming_time_ms);
+  c.resume_after = core::from_ms(s.resume_after_ms);
+  c.tracker_timeout = core::from_ms(s.tracker_timeout_ms);
+  c.tracker_confidence_recover = core::from_ms(s.tracker_confidence_recover_ms);
+  c.person_max_distance_m = s.person_max_distance_m;
+  c.lidar_timeout = core::from_ms(s.lidar_timeout_ms);
+  c.costmap_max_age = core::from_ms(s.costmap_max_age_ms);
+  c.base_feedback_timeout = core::from_ms(s.base_feedback_timeout_ms);
+  c.control_stall_timeout = core::from_ms(s.control_stall_timeout_ms);
+  return c;
+}
+
+core::StopLimits stop_limits(const DaemonConfig& cfg) {
+  return core::StopLimits{cfg.supervisor.stop_linear_decel_mps2,
+                          cfg.supervisor.stop_angular_decel_radps2,
+                          core::from_ms(cfg.supervisor.stop_max_time_ms)};
+}
+
+Daemon::Daemon(const DaemonConfig& cfg, hal::SystemdNotifier& notifier)
+    : cfg_(cfg),
+      notifier_(notifier),
+      supervisor_(supervisor_config(cfg)),
+      watchdog_interval_(hal::SystemdNotifier::watchdog_interval()),
+      gate_(stop_limits(cfg)) {}
+
+std::vector<TaskBinding> Daemon::bindings() {
+  std::vector<TaskBinding> out;
+  for (const TaskRow& row : task_table()) {
+    const DaemonTaskFn fn = row.fn;
+    out.push_back(TaskBinding{row.spec, [this, fn](const core::Tick& t) { (this->*fn)(t); }});
+  }
+  return out;
+}
+
+bool Daemon::shutdown_complete() const {
+  if (!shutdown_.load(std::memory_order_acquire)) return false;
+  const auto s = safety_.read();
+  const auto c = command_.read();
+  return s && s->value.reason == core::Reason::kShutdown && c && c->value.is_zero() &&
+         c->stamp >= s->stamp;
+}
+
+// ---- input tasks: empty until their drivers land (the table's `pending` says so) ------------
+
+void Daemon::tracker_task(const core::Tick& /*tick*/) {}
+void Daemon::base_task(const core::Tick& /*tick*/) {}
+void Daemon::lidar_task(const core::Tick& /*tick*/) {}
+void Daemon::policy_task(const core::Tick& /*tick*/) {}
+
+// ---- control: everything that can move the robot passes the supervisor's gate ---------------
+
+void Daemon::control_task(const core::Tick& tick) {
+  const auto safety = safety_.read();
+  const bool allowed = safety && safety->value.motion_allowed;
+  // No controller yet (issue 6): request standstill. The gate still runs so the stop ramp and
+  // the command stream are real.
+  const core::BodyVelocity requested{};
+  command_.publish(gate_.update(allowed, requested, tick.now), tick.now);
+}
+
+// ---- supervisor ------------------------------------------------------------------------------
+
+void Daemon::supervisor_task(const core::Tick& tick) {
+  core::SafetyInputs in;
+  in.initialized = initialized_.load(std::memory_order_acquire);
+  in.shutdown = shutdown_.load(std::memory_order_acquire);
+  if (in.initialized && initialized_at_ == core::kNever) initialized_at_ = tick.now;
+
+  if (executor_ != nullptr) {
+    const size_t control = executor_->find("control");
+    if (control < executor_->task_count()) {
+      const core::TaskStats& st = executor_->stats(control);
+      // Before the control task's first run, its heartbeat counts from start-up.
+      in.control_heartbeat = st.runs() > 0 ? st.last_end() : initialized_at_;
+      in.control_overruns = st.overruns();
+    }
+  }
+
+  const core::SupervisorOutput out = supervisor_.update(in, tick.now);
+  if (out.transitioned) {
+    const auto& tr = out.transition;
+    const bool bad = tr.to == core::SafetyState::kHold || tr.to == core::SafetyState::kFault;
+    const std::string line =
+        tr.reason == core::Reason::kNone
+            ? fmt::format("{} -> {} ({})", core::state_name(tr.from), core::state_name(tr.to),
+                          tr.values.data())
+            : fmt::format("{} -> {}: {} [reason {} {}] ({})", core::state_name(tr.from),
+                          core::state_name(tr.to), core::reason_text(tr.reason),
+                          static_cast<int>(tr.reason), core::reason_name(tr.reason),
+                          tr.values.data());
+    if (bad) {
+      spdlog::warn("safety: {}", line);
+    } else {
+      spdlog::info("safety: {}", line);
+    }
+  }
+
+  SafetySnapshot snap;
+  snap.state = out.state;
+  snap.reason = out.reason;
+  snap.motion_allowed = out.motion_allowed;
+  snap.active_mask = static_cast<uint32_t>(out.active.to_ulong());
+  safety_.publish(snap, tick.now);
+
+  // systemd watchdog: pinged only while the control task makes progress.
+  if (out.watchdog_ok && watchdog_interval_) {
+    const Nanos every = std::chrono::duration_cast<Nanos>(*watchdog_interval_) / 4;
+    if (last_watchdog_ping_ == core::kNever || tick.now - last_watchdog_ping_ >= every) {
+      notifier_.watchdog();
+      last_watchdog_ping_ = tick.now;
+    }
+  }
+}
+
+// ---- report: status line, summaries (not real-time) ------------------------------------------
+
+std::string Daemon::safety_text(const SafetySnapshot& s) const {
+  std::string text(core::state_name(s.state));
+  if (s.reason != core::Reason::kNone) text += fmt::format(": {}", core::reason_text(s.reason));
+  std::string others;
+  int n_others = 0;
+  for (size_t i = 0; i < core::kReasonCount; ++i) {
+    if ((s.active_mask >> i & 1U) != 0 && core::kReasonTable[i].reason != s.reason) {
+      others += fmt::format("{}{}", others.empty() ? "" : ", ", core::kReasonTable[i].text);
+      ++n_others;
+    }
+  }
+  if (n_others > 0) text += fmt::format(" (also: {})", others);
+  return text;
+}
+
+void Daemon::report_task(const core::Tick& tick) {
+  if (executor_ == nullptr) return;
+  const size_t n = executor_->task_count();
+  if (last_runs_.size() != n) {
+    last_runs_.assign(n, 0);
+    measured_rate_hz_.assign(n, 0.0);
+  }
+  if (last_report_ != core::kNever) {
+    const double dt = core::to_seconds(tick.now - last_report_);
+    for (size_t i = 0; i < n; ++i) {
+      const uint64_t runs = executor_->stats(i).runs();
+      measured_rate_hz_[i] = dt > 0 ? static_cast<double>(runs - last_runs_[i]) / dt : 0.0;
+    }
+  }
+  for (size_t i = 0; i < n; ++i) last_runs_[i] = executor_->stats(i).runs();
+  last_report_ = tick.now;
+
+  const auto safety = safety_.read();
+  std::string line = safety ? safety_text(safety->value) : std::string("INIT: starting up");
+  std::string rates;
+  std::string shells;
+  for (size_t i = 0; i < n; ++i) {
+    const auto& spec = executor_->spec(i);
+    rates += fmt::format("{}{} {:.0f}Hz", rates.empty() ? "" : " ", spec.name, measured_rate_hz_[i]);
+    for (const TaskRow& row : task_table()) {
+      if (row.spec.name == spec.name && !row.pending.empty()) {
+        shells += fmt::format("{}{}", shells.empty() ? "" : ", ", spec.name);
+      }
+    }
+  }
+  line += " | " + rates;
+  if (!shells.empty()) line += " | not yet implemented: " + shells;
+  status_ = line;
+  if (status_ != last_status_sent_) {
+    notifier_.status(status_);
+    last_status_sent_ = status_;
+  }
+
+  const Nanos summary_every =
+      std::chrono::duration_cast<Nanos>(std::chrono::duration<double>(cfg_.logging.summary_period_s));
+  if (last_summary_ == core::kNever || tick.now - last_summary_ >= summary_every) {
+    spdlog::info("status: {}", status_);
+    spdlog::info("timing: {}", timing_summary());
+    last_summary_ = tick.now;
+  }
+}
+
+std::string Daemon::status_line() const { return status_; }
+
+std::string Daemon::timing_summary() const {
+  if (executor_ == nullptr) return {};
+  std::string out;
+  for (size_t i = 0; i < executor_->task_count(); ++i) {
+    const auto& st = executor_->stats(i);
+    const double rate = i < measured_rate_hz_.size() ? measured_rate_hz_[i] : 0.0;
+    out += fmt::format(
+        "{}{} {:.1f}Hz jitter p50/p99/max {:.0f}/{:.0f}/{:.0f}us run p99/max {:.0f}/{:.0f}us "
+        "over {} skip {} budget {}",
+        out.empty() ? "" : "; ", executor_->spec(i).name, rate,
+        core::to_us(st.period_jitter().quantile(0.5)), core::to_us(st.period_jitter().quantile(0.99)),
+        core::to_us(st.period_jitter().max()), core::to_us(st.run_time().quantile(0.99)),
+        core::to_us(st.run_time().max()), st.overruns(), st.skipped(), st.budget_exceeded());
+  }
+  return out;
+}
+
+}  // namespace firmware

@@ -1,0 +1,39 @@
+#include "firmware/task_table.hpp"
+
+#include "firmware/daemon.hpp"
+
+namespace firmware {
+
+const std::array<core::GroupSpec, 4>& group_table() {
+  // SCHED_FIFO priorities, all below 50 (the kernel's threaded IRQ handlers).
+  static constexpr std::array<core::GroupSpec, 4> kGroups{{
+      {"realtime", 45},    // inputs at their rates, supervisor, 100 Hz control
+      {"planning", 35},    // 30 Hz companion-point selection
+      {"perception", 25},  // 10 Hz lidar: long runs must never delay the groups above
+      {"report", 0},       // status and summaries: not real-time (priority 0 = SCHED_OTHER)
+  }};
+  return kGroups;
+}
+
+// COMPANION_TASK(name, rate_hz, budget_us, group, priority, pending)
+//   priority orders tasks due at the same instant within a group (and in single-thread mode):
+//   fresh inputs first, then the supervisor's judgement, then the control output it gates.
+#define COMPANION_TASK(name, rate_hz, budget_us, group, priority, pending) \
+  TaskRow { core::TaskSpec{#name, rate_hz, budget_us, group, priority}, &Daemon::name##_task, pending }
+
+const std::array<TaskRow, 7>& task_table() {
+  static const std::array<TaskRow, 7> kTable{{
+      COMPANION_TASK(tracker, 120, 300, kGroupRealtime, 90, "Amfitrack driver (issue 5)"),
+      COMPANION_TASK(base, 50, 200, kGroupRealtime, 80, "Scout Mini CAN driver (issue 3)"),
+      COMPANION_TASK(supervisor, 100, 50, kGroupRealtime, 70, ""),
+      COMPANION_TASK(control, 100, 3000, kGroupRealtime, 60, "MPPI-CBF controller (issue 6)"),
+      COMPANION_TASK(policy, 30, 500, kGroupPlanning, 50, "companion-point selection (issue 6)"),
+      COMPANION_TASK(lidar, 10, 5000, kGroupPerception, 40, "VLP-16 driver and costmap (issue 4)"),
+      COMPANION_TASK(report, 1, 2000, kGroupReport, 10, ""),
+  }};
+  return kTable;
+}
+
+#undef COMPANION_TASK
+
+}  // namespace firmware

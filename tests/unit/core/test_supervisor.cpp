@@ -1,0 +1,343 @@
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "core/safety/supervisor.hpp"
+
+using namespace std::chrono_literals;
+using core::Nanos;
+using core::Reason;
+using core::SafetyInputs;
+using core::SafetyState;
+using core::Supervisor;
+using core::SupervisorConfig;
+using core::TrackerConfidence;
+
+namespace {
+
+// Drives a supervisor at 100 Hz with inputs that are healthy unless a test says otherwise.
+class Harness {
+ public:
+  explicit Harness(SupervisorConfig cfg = {}) : sup_(cfg) {}
+
+  // Fresh, healthy inputs at `now_`.
+  SafetyInputs healthy() const {
+    SafetyInputs in;
+    in.initialized = true;
+    in.tracker_stamp = now_;
+    in.tracker_confidence = TrackerConfidence::kGood;
+    in.person_distance_m = 1.0;
+    in.lidar_stamp = now_;
+    in.costmap_stamp = now_;
+    in.base_feedback_stamp = now_;
+    in.control_heartbeat = now_;
+    return in;
+  }
+
+  // Runs for `d` with inputs built by `make` each 10 ms tick; returns the last output and counts
+  // transitions.
+  template <typename F>
+  core::SupervisorOutput run(Nanos d, F make) {
+    core::SupervisorOutput out;
+    const Nanos end = now_ + d;
+    while (now_ < end) {
+      now_ += 10ms;
+      out = sup_.update(make(), now_);
+      if (out.transitioned) {
+        ++transitions_;
+        last_transition_ = out.transition;
+      }
+      // The invariant the whole safety model rests on.
+      EXPECT_EQ(out.motion_allowed, out.state == SafetyState::kActive);
+    }
+    return out;
+  }
+  core::SupervisorOutput run_healthy(Nanos d) {
+    return run(d, [&] { return healthy(); });
+  }
+  void arm() {
+    const auto out = run_healthy(1100ms);
+    ASSERT_EQ(out.state, SafetyState::kActive);
+    transitions_ = 0;
+  }
+
+  Supervisor sup_;
+  Nanos now_ = 100s;
+  int transitions_ = 0;
+  core::Transition last_transition_{};
+};
+
+std::string values(const core::Transition& t) { return std::string(t.values.data()); }
+
+}  // namespace
+
+TEST(Supervisor, StartsInInitAndArmsAfterArmingTimeOfHealthyInputs) {
+  Harness h;
+  auto out = h.run(50ms, [&] {
+    auto in = h.healthy();
+    in.initialized = false;
+    return in;
+  });
+  EXPECT_EQ(out.state, SafetyState::kInit);
+  EXPECT_FALSE(out.motion_allowed);
+  out = h.run_healthy(500ms);
+  EXPECT_EQ(out.state, SafetyState::kArming);
+  out = h.run_healthy(600ms);
+  EXPECT_EQ(out.state, SafetyState::kActive);
+  EXPECT_EQ(out.reason, Reason::kNone);
+  EXPECT_TRUE(out.motion_allowed);
+}
+
+TEST(Supervisor, WithNoInputsAtAllItHoldsBecauseTheTrackerIsSilent) {
+  Harness h;
+  SafetyInputs in;
+  in.initialized = true;
+  const auto out = h.run(300ms, [&] {
+    in.control_heartbeat = h.now_;
+    return in;
+  });
+  EXPECT_EQ(out.state, SafetyState::kHold);
+  EXPECT_EQ(out.reason, Reason::kTrackerSilent);
+  EXPECT_TRUE(out.active[core::reason_index(Reason::kLidarSilent)]);
+  EXPECT_TRUE(out.active[core::reason_index(Reason::kBaseFeedbackSilent)]);
+  EXPECT_EQ(std::string(core::reason_text(out.reason)), "tracker silent");
+}
+
+TEST(Supervisor, TrackerSilenceHoldsWithTheAgeInTheTransition) {
+  Harness h;
+  h.arm();
+  const Nanos last_frame = h.now_;
+  const auto out = h.run(200ms, [&] {
+    auto in = h.healthy();
+    in.tracker_stamp = last_frame;
+    return in;
+  });
+  EXPECT_EQ(out.state, SafetyState::kHold);
+  EXPECT_EQ(out.reason, Reason::kTrackerSilent);
+  EXPECT_EQ(h.transitions_, 1) << "one transition, not one per tick";
+  EXPECT_EQ(h.last_transition_.from, SafetyState::kActive);
+  EXPECT_NE(values(h.last_transition_).find("tracker age 110.0 ms > timeout 100.0 ms"),
+            std::string::npos)
+      << values(h.last_transition_);
+}
+
+TEST(Supervisor, LowConfidenceStopsAndResumesOnlyAfterTheRecoverTime) {
+  SupervisorConfig cfg;
+  cfg.tracker_confidence_recover = 1000ms;
+  Harness h(cfg);
+  h.arm();
+  auto bad = [&] {
+    auto in = h.healthy();
+    in.tracker_confidence = TrackerConfidence::kBad;
+    return in;
+  };
+  auto out = h.run(10ms, bad);
+  EXPECT_EQ(out.state, SafetyState::kHold) << "trips on the first BAD frame";
+  EXPECT_EQ(out.reason, Reason::kTrackerConfidenceLow);
+  EXPECT_NE(values(h.last_transition_).find("BAD"), std::string::npos);
+
+  // GOOD for 900 ms, then BAD again: the clock restarts.
+  out = h.run_healthy(900ms);
+  EXPECT_EQ(out.state, SafetyState::kHold);
+  out = h.run(10ms, bad);
+  out = h.run_healthy(990ms);
+  EXPECT_EQ(out.state, SafetyState::kHold);
+  out = h.run_healthy(30ms);
+  EXPECT_EQ(out.state, SafetyState::kActive);
+  EXPECT_EQ(h.transitions_, 2) << "ACTIVE->HOLD and HOLD->ACTIVE, nothing in between";
+}
+
+TEST(Supervisor, DegradedConfidenceDoesNotStop) {
+  Harness h;
+  h.arm();
+  const auto out = h.run(500ms, [&] {
+    auto in = h.healthy();
+    in.tracker_confidence = TrackerConfidence::kDegraded;
+    return in;
+  });
+  EXPECT_EQ(out.state, SafetyState::kActive);
+}
+
+TEST(Supervisor, PersonTooFarIsPersonLost) {
+  Harness h;
+  h.arm();
+  const auto out = h.run(20ms, [&] {
+    auto in = h.healthy();
+    in.person_distance_m = 3.5;
+    return in;
+  });
+  EXPECT_EQ(out.reason, Reason::kPersonLost);
+  EXPECT_NE(values(h.last_transition_).find("3.50 m > 3.00 m"), std::string::npos);
+}
+
+TEST(Supervisor, StaleCostmapWithLiveLidarIsCostmapStale) {
+  Harness h;
+  h.arm();
+  const Nanos built = h.now_;
+  const auto out = h.run(600ms, [&] {
+    auto in = h.healthy();
+    in.costmap_stamp = built;
+    return in;
+  });
+  EXPECT_EQ(out.reason, Reason::kCostmapStale);
+}
+
+TEST(Supervisor, BaseFaultLatchesUntilClearedByTheOperator) {
+  Harness h;
+  h.arm();
+  auto out = h.run(20ms, [&] {
+    auto in = h.healthy();
+    in.base_fault_word = 0x0008;
+    return in;
+  });
+  EXPECT_EQ(out.state, SafetyState::kFault);
+  EXPECT_EQ(out.reason, Reason::kBaseFault);
+  EXPECT_NE(values(h.last_transition_).find("0x0008"), std::string::npos);
+
+  // Cause gone: still FAULT (latched).
+  out = h.run_healthy(5s);
+  EXPECT_EQ(out.state, SafetyState::kFault);
+
+  // A clear while the cause is present is refused.
+  auto faulty = h.healthy();
+  faulty.base_fault_word = 0x0008;
+  EXPECT_FALSE(h.sup_.request_fault_clear(faulty, h.now_));
+  EXPECT_EQ(h.sup_.state(), SafetyState::kFault);
+
+  EXPECT_TRUE(h.sup_.request_fault_clear(h.healthy(), h.now_));
+  EXPECT_EQ(h.sup_.state(), SafetyState::kArming);
+  out = h.run_healthy(1100ms);
+  EXPECT_EQ(out.state, SafetyState::kActive);
+}
+
+TEST(Supervisor, FaultOutranksHold) {
+  Harness h;
+  h.arm();
+  const auto out = h.run(20ms, [&] {
+    auto in = h.healthy();
+    in.tracker_stamp = core::kNever;
+    in.base_estop = true;
+    return in;
+  });
+  EXPECT_EQ(out.state, SafetyState::kFault);
+  EXPECT_EQ(out.reason, Reason::kBaseEstop);
+  EXPECT_TRUE(out.active[core::reason_index(Reason::kTrackerSilent)]);
+}
+
+TEST(Supervisor, NewControlOverrunHoldsThenResumes) {
+  Harness h;
+  h.arm();
+  uint64_t overruns = 0;
+  auto out = h.run(10ms, [&] {
+    auto in = h.healthy();
+    in.control_overruns = ++overruns;
+    return in;
+  });
+  EXPECT_EQ(out.reason, Reason::kControlOverrun);
+  out = h.run(1100ms, [&] {
+    auto in = h.healthy();
+    in.control_overruns = overruns;  // no new overrun
+    return in;
+  });
+  EXPECT_EQ(out.state, SafetyState::kActive);
+}
+
+TEST(Supervisor, StalledControlFaultsAndStopsTheWatchdog) {
+  Harness h;
+  h.arm();
+  const Nanos last_beat = h.now_;
+  auto out = h.run(50ms, [&] {
+    auto in = h.healthy();
+    in.control_heartbeat = last_beat;
+    return in;
+  });
+  EXPECT_TRUE(out.watchdog_ok) << "50 ms is within the 100 ms stall timeout";
+  out = h.run(100ms, [&] {
+    auto in = h.healthy();
+    in.control_heartbeat = last_beat;
+    return in;
+  });
+  EXPECT_FALSE(out.watchdog_ok);
+  EXPECT_EQ(out.state, SafetyState::kFault);
+  EXPECT_EQ(out.reason, Reason::kControlStalled);
+}
+
+TEST(Supervisor, WatchdogIsFedWhileHoldingIfControlRuns) {
+  Harness h;
+  SafetyInputs in;
+  in.initialized = true;
+  const auto out = h.run(300ms, [&] {
+    in.control_heartbeat = h.now_;
+    return in;
+  });
+  EXPECT_EQ(out.state, SafetyState::kHold);
+  EXPECT_TRUE(out.watchdog_ok);
+}
+
+TEST(Supervisor, OperatorStopHoldsAndResumes) {
+  Harness h;
+  h.arm();
+  auto out = h.run(20ms, [&] {
+    auto in = h.healthy();
+    in.operator_stop = true;
+    return in;
+  });
+  EXPECT_EQ(out.reason, Reason::kOperatorStop);
+  out = h.run_healthy(1100ms);
+  EXPECT_EQ(out.state, SafetyState::kActive);
+}
+
+TEST(Supervisor, ShutdownIsTerminalEvenFromFault) {
+  Harness h;
+  h.arm();
+  (void)h.run(20ms, [&] {
+    auto in = h.healthy();
+    in.numerical_failure = true;
+    return in;
+  });
+  ASSERT_EQ(h.sup_.state(), SafetyState::kFault);
+  auto out = h.run(20ms, [&] {
+    auto in = h.healthy();
+    in.shutdown = true;
+    return in;
+  });
+  EXPECT_EQ(out.state, SafetyState::kHold);
+  EXPECT_EQ(out.reason, Reason::kShutdown);
+  EXPECT_FALSE(h.sup_.request_fault_clear(h.healthy(), h.now_));
+  out = h.run(2s, [&] {
+    auto in = h.healthy();
+    in.shutdown = true;
+    return in;
+  });
+  EXPECT_EQ(out.reason, Reason::kShutdown);
+}
+
+TEST(Supervisor, DisabledFamiliesAreNotSupervised) {
+  SupervisorConfig cfg;
+  cfg.require_lidar = false;
+  cfg.require_base = false;
+  Harness h(cfg);
+  const auto out = h.run(1100ms, [&] {
+    auto in = h.healthy();
+    in.lidar_stamp = core::kNever;
+    in.base_feedback_stamp = core::kNever;
+    return in;
+  });
+  EXPECT_EQ(out.state, SafetyState::kActive);
+}
+
+TEST(Supervisor, ReasonCodesAreStable) {
+  // Numbers are an interface (logs, tools): this test fails if anyone renumbers.
+  EXPECT_EQ(static_cast<int>(Reason::kTrackerConfidenceLow), 10);
+  EXPECT_EQ(static_cast<int>(Reason::kTrackerSilent), 11);
+  EXPECT_EQ(static_cast<int>(Reason::kLidarSilent), 20);
+  EXPECT_EQ(static_cast<int>(Reason::kBaseFeedbackSilent), 30);
+  EXPECT_EQ(static_cast<int>(Reason::kCanBusOff), 40);
+  EXPECT_EQ(static_cast<int>(Reason::kControlOverrun), 50);
+  EXPECT_EQ(static_cast<int>(Reason::kOperatorStop), 60);
+  EXPECT_EQ(static_cast<int>(Reason::kShutdown), 61);
+  for (const auto& info : core::kReasonTable) {
+    EXPECT_EQ(core::reason_info(info.reason), &info);
+    EXPECT_FALSE(info.name.empty());
+  }
+}
