@@ -8,6 +8,11 @@ namespace firmware {
 
 using core::Nanos;
 
+namespace {
+// A safety snapshot older than this means the supervisor task is not running.
+constexpr Nanos kSnapshotMaxAge = std::chrono::milliseconds(100);
+}  // namespace
+
 core::SupervisorConfig supervisor_config(const DaemonConfig& cfg) {
   const auto& s = cfg.supervisor;
   core::SupervisorConfig c;
@@ -112,16 +117,24 @@ void Daemon::supervisor_task(const core::Tick& tick) {
   snap.state = out.state;
   snap.reason = out.reason;
   snap.motion_allowed = out.motion_allowed;
+  snap.watchdog_ok = out.watchdog_ok;
   snap.active_mask = static_cast<uint32_t>(out.active.to_ulong());
   safety_.publish(snap, tick.now);
+}
 
-  // systemd watchdog: pinged only while the control task makes progress.
-  if (out.watchdog_ok && watchdog_interval_) {
-    const Nanos every = std::chrono::duration_cast<Nanos>(*watchdog_interval_) / 4;
-    if (last_watchdog_ping_ == core::kNever || tick.now - last_watchdog_ping_ >= every) {
-      notifier_.watchdog();
-      last_watchdog_ping_ = tick.now;
-    }
+// ---- notify: systemd watchdog, off the real-time threads ----------------------------------------
+
+void Daemon::notify_task(const core::Tick& tick) {
+  // The supervisor decides (control task progressing); this task only sends, on a non-real-time
+  // thread, because a notification socket that is not read blocks the sender. A supervisor that
+  // stopped publishing (stale snapshot) stops the pings too.
+  if (!watchdog_interval_) return;
+  const auto s = safety_.read();
+  if (!s || !s->value.watchdog_ok || tick.now - s->stamp > kSnapshotMaxAge) return;
+  const Nanos every = std::chrono::duration_cast<Nanos>(*watchdog_interval_) / 4;
+  if (last_watchdog_ping_ == core::kNever || tick.now - last_watchdog_ping_ >= every) {
+    notifier_.watchdog();
+    last_watchdog_ping_ = tick.now;
   }
 }
 

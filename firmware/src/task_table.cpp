@@ -21,15 +21,16 @@ const std::array<core::GroupSpec, 4>& group_table() {
 #define COMPANION_TASK(name, rate_hz, budget_us, group, priority, pending) \
   TaskRow { core::TaskSpec{#name, rate_hz, budget_us, group, priority}, &Daemon::name##_task, pending }
 
-const std::array<TaskRow, 7>& task_table() {
-  static const std::array<TaskRow, 7> kTable{{
+const std::array<TaskRow, 8>& task_table() {
+  static const std::array<TaskRow, 8> kTable{{
       COMPANION_TASK(tracker, 120, 300, kGroupRealtime, 90, "Amfitrack driver (issue 5)"),
       COMPANION_TASK(base, 50, 200, kGroupRealtime, 80, "Scout Mini CAN driver (issue 3)"),
       COMPANION_TASK(supervisor, 100, 50, kGroupRealtime, 70, ""),
       COMPANION_TASK(control, 100, 3000, kGroupRealtime, 60, "MPPI-CBF controller (issue 6)"),
       COMPANION_TASK(policy, 30, 500, kGroupPlanning, 50, "companion-point selection (issue 6)"),
       COMPANION_TASK(lidar, 10, 5000, kGroupPerception, 40, "VLP-16 driver and costmap (issue 4)"),
-      COMPANION_TASK(report, 1, 2000, kGroupReport, 10, ""),
+      COMPANION_TASK(notify, 10, 200, kGroupReport, 20, ""),  // systemd watchdog pings
+      COMPANION_TASK(report, 1, 2000, kGroupReport, 10, ""),  // status line, summaries
   }};
   return kTable;
 }

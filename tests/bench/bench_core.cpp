@@ -46,7 +46,7 @@ void BM_TaskStatsRecord(benchmark::State& state) {
   core::Nanos t = 0ns;
   for (auto _ : state) {
     t += 10ms;
-    stats.record(core::TaskTiming{t, t + 20us, t + 500us, t + 10ms, 0});
+    stats.record(core::TaskTiming{t, t, t + 20us, t + 500us, t + 10ms, 0});
   }
 }
 BENCHMARK(BM_TaskStatsRecord);

@@ -30,7 +30,7 @@ ReleaseSchedule::Claim ReleaseSchedule::claim(Nanos start) {
     while (release_at(estimate + 1) <= start) ++estimate;
     k = std::max(k, estimate);
   }
-  Claim c{release_at(k), k - next_k_, release_at(k + 1)};
+  Claim c{release_at(next_k_), release_at(k), k - next_k_, release_at(k + 1)};
   next_k_ = k + 1;
   return c;
 }

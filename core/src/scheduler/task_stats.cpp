@@ -13,7 +13,7 @@ void TaskStats::record(const TaskTiming& t) {
     const Nanos interval = t.start - Nanos(prev_start);
     period_jitter_.record(interval > period_ ? interval - period_ : period_ - interval);
   }
-  start_latency_.record(t.start - t.release);
+  start_latency_.record(t.start - t.due);
   const Nanos run = t.end - t.start;
   run_time_.record(run);
   if (run > budget_) bump(budget_exceeded_);

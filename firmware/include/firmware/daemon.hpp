@@ -21,6 +21,7 @@ struct SafetySnapshot {
   core::SafetyState state = core::SafetyState::kInit;
   core::Reason reason = core::Reason::kStarting;
   bool motion_allowed = false;
+  bool watchdog_ok = false;  // the control task makes progress: systemd may be pinged
   uint32_t active_mask = 0;  // bit i = kReasonTable[i] present
 };
 static_assert(core::kReasonCount <= 32, "active_mask holds one bit per reason");
@@ -51,6 +52,7 @@ class Daemon {
   void control_task(const core::Tick& tick);
   void supervisor_task(const core::Tick& tick);
   void report_task(const core::Tick& tick);
+  void notify_task(const core::Tick& tick);
 
   // Channels (read side), for tools and tests.
   [[nodiscard]] const core::LatestValue<SafetySnapshot>& safety() const { return safety_; }

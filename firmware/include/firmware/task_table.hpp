@@ -23,6 +23,6 @@ struct TaskRow {
 enum Group : uint8_t { kGroupRealtime = 0, kGroupPlanning = 1, kGroupPerception = 2, kGroupReport = 3 };
 
 const std::array<core::GroupSpec, 4>& group_table();
-const std::array<TaskRow, 7>& task_table();
+const std::array<TaskRow, 8>& task_table();
 
 }  // namespace firmware

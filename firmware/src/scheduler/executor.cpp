@@ -65,7 +65,7 @@ void Executor::run_loop(std::span<const size_t> task_indices, core::Nanos origin
       last_start[pick] = start;
       tasks_[task].fn(core::Tick{start, period, claim.release});
       const core::Nanos end = clock_.now();
-      stats_[task]->record(core::TaskTiming{claim.release, start, end, claim.following,
+      stats_[task]->record(core::TaskTiming{claim.first_due, claim.release, start, end, claim.following,
                                             claim.skipped});
     }
   }
@@ -105,6 +105,7 @@ void Executor::start(core::Nanos origin, bool realtime) {
 void Executor::run(core::Nanos origin) {
   std::vector<size_t> all(tasks_.size());
   std::iota(all.begin(), all.end(), size_t{0});
+  const hal::ClockThreadGuard attached(clock_);  // a SimClock is idle only while we sleep
   run_loop(all, origin);
 }
 

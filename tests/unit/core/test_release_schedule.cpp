@@ -32,6 +32,7 @@ TEST(ReleaseSchedule, ALateStartSkipsMissedReleasesInsteadOfBursting) {
   ReleaseSchedule s(100, 0s);
   (void)s.claim(0s);
   const auto c = s.claim(35ms);  // releases 10, 20, 30 ms are due; serve 30, skip 10 and 20
+  EXPECT_EQ(c.first_due, 10ms);
   EXPECT_EQ(c.release, 30ms);
   EXPECT_EQ(c.skipped, 2U);
   EXPECT_EQ(s.next_release(), 40ms);

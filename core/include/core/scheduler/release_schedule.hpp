@@ -17,6 +17,7 @@ class ReleaseSchedule {
   [[nodiscard]] uint32_t rate_hz() const { return rate_hz_; }
 
   struct Claim {
+    Nanos first_due;   // the earliest release that was pending (lateness is measured from it)
     Nanos release;     // the release this run serves (latest release <= start)
     uint64_t skipped;  // releases that passed without a run (the task was late)
     Nanos following;   // the release after this run: its deadline

@@ -10,7 +10,8 @@
 namespace core {
 
 struct TaskTiming {
-  Nanos release;    // when the run was due
+  Nanos due;        // the earliest release that was waiting for this run
+  Nanos release;    // the release it serves (later than `due` when releases were skipped)
   Nanos start;      // when it began
   Nanos end;        // when it returned
   Nanos deadline;   // the next release
@@ -39,7 +40,7 @@ class TaskStats {
 
   // |actual start-to-start interval - nominal period|.
   [[nodiscard]] const DurationHistogram& period_jitter() const { return period_jitter_; }
-  // start - release (how late the run began).
+  // start - due: how late the run began after the first release it was waiting for.
   [[nodiscard]] const DurationHistogram& start_latency() const { return start_latency_; }
   [[nodiscard]] const DurationHistogram& run_time() const { return run_time_; }
   [[nodiscard]] Nanos nominal_period() const { return period_; }

@@ -1,0 +1,159 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "firmware/config/config_loader.hpp"
+
+using firmware::ConfigResult;
+using firmware::load_config_text;
+
+namespace {
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Exactly one error, at `line`, about `key`, whose message contains `text`.
+void expect_error(const ConfigResult& r, int line, const std::string& key, const std::string& text) {
+  ASSERT_FALSE(r.ok());
+  ASSERT_EQ(r.errors.size(), 1U) << r.errors[0].to_string();
+  const auto& e = r.errors[0];
+  EXPECT_EQ(e.file, "test.yaml");
+  EXPECT_EQ(e.line, line) << e.to_string();
+  EXPECT_EQ(e.key, key) << e.to_string();
+  EXPECT_NE(e.message.find(text), std::string::npos) << e.to_string();
+  // The printed form names file, line and key.
+  EXPECT_NE(e.to_string().find("test.yaml:" + std::to_string(line) + ": '" + key + "'"),
+            std::string::npos)
+      << e.to_string();
+}
+
+}  // namespace
+
+TEST(Config, DefaultsLoadAndMatchThePaper) {
+  const auto r = firmware::load_default_config();
+  ASSERT_TRUE(r.ok()) << r.errors[0].to_string();
+  const auto& c = *r.config;
+  EXPECT_EQ(c.interactive_space.points, 64);
+  EXPECT_DOUBLE_EQ(c.interactive_space.ellipse_a_m, 1.0);
+  EXPECT_DOUBLE_EQ(c.interactive_space.ellipse_b_m, 0.7);
+  EXPECT_DOUBLE_EQ(c.interactive_space.cost_threshold, 30);
+  EXPECT_EQ(c.mppi.horizon_steps, 100);
+  EXPECT_EQ(c.mppi.samples, 2000);
+  EXPECT_DOUBLE_EQ(c.mppi.step_s, 0.1);
+  EXPECT_DOUBLE_EQ(c.mppi.lambda, 1.0);
+  EXPECT_DOUBLE_EQ(c.mppi.q_x, 50);
+  EXPECT_DOUBLE_EQ(c.mppi.q_y, 10);
+  EXPECT_DOUBLE_EQ(c.mppi.q_theta, 20);
+  EXPECT_DOUBLE_EQ(c.mppi.collision_cost, 1000);
+  EXPECT_DOUBLE_EQ(c.dcbf.delta, 0.5);
+  EXPECT_DOUBLE_EQ(c.dcbf.c_safe, 5000);
+}
+
+TEST(Config, ShippedDefaultFileIsTheBuiltInOne) {
+  EXPECT_EQ(read_file(std::string(COMPANION_SOURCE_DIR) + "/config/companiond.yaml"),
+            firmware::default_config_yaml());
+}
+
+TEST(Config, ReferenceDocumentIsUpToDate) {
+  // config/README.md is generated: `companiond --config-reference > config/README.md`.
+  EXPECT_EQ(read_file(std::string(COMPANION_SOURCE_DIR) + "/config/README.md"),
+            firmware::config_reference_markdown());
+}
+
+TEST(Config, PartialFileOverridesOnlyItsKeys) {
+  const auto r = load_config_text("supervisor:\n  tracker_timeout_ms: 50\n", "test.yaml");
+  ASSERT_TRUE(r.ok()) << r.errors[0].to_string();
+  EXPECT_EQ(r.config->supervisor.tracker_timeout_ms, 50);
+  EXPECT_EQ(r.config->supervisor.lidar_timeout_ms, 300);
+}
+
+TEST(Config, EmptyFileMeansDefaults) {
+  EXPECT_TRUE(load_config_text("", "test.yaml").ok());
+  EXPECT_TRUE(load_config_text("# only a comment\n", "test.yaml").ok());
+}
+
+TEST(Config, PrintedConfigLoadsBackToTheSameValues) {
+  auto r = load_config_text("mppi:\n  samples: 512\ndevices:\n  base: \"slcan:/dev/ttyACM0\"\n",
+                            "test.yaml");
+  ASSERT_TRUE(r.ok());
+  const std::string printed = firmware::print_config(*r.config);
+  const auto again = load_config_text(printed, "printed.yaml");
+  ASSERT_TRUE(again.ok()) << again.errors[0].to_string();
+  EXPECT_EQ(firmware::print_config(*again.config), printed);
+  EXPECT_NE(printed.find("samples: 512"), std::string::npos);
+}
+
+TEST(Config, UnknownKeyIsRefused) {
+  expect_error(load_config_text("supervisor:\n  tracker_timeout_ms: 50\n  tracker_timout_ms: 60\n",
+                                "test.yaml"),
+               3, "supervisor.tracker_timout_ms", "unknown key");
+}
+
+TEST(Config, UnknownSectionIsRefused) {
+  expect_error(load_config_text("supervisr:\n  x: 1\n", "test.yaml"), 1, "supervisr",
+               "unknown key");
+}
+
+TEST(Config, DuplicateKeyIsRefused) {
+  expect_error(load_config_text("mppi:\n  samples: 100\n  samples: 200\n", "test.yaml"), 3,
+               "mppi.samples", "duplicate");
+}
+
+TEST(Config, WrongTypesAreRefused) {
+  expect_error(load_config_text("mppi:\n  lambda: fast\n", "test.yaml"), 2, "mppi.lambda",
+               "expected a finite number");
+  expect_error(load_config_text("mppi:\n  samples: 2000.5\n", "test.yaml"), 2, "mppi.samples",
+               "expected an integer");
+  expect_error(load_config_text("realtime:\n  require: maybe\n", "test.yaml"), 2,
+               "realtime.require", "expected true or false");
+  expect_error(load_config_text("mppi:\n  lambda: .nan\n", "test.yaml"), 2, "mppi.lambda",
+               "finite");
+  expect_error(load_config_text("mppi:\n  samples: [1, 2]\n", "test.yaml"), 2, "mppi.samples",
+               "list");
+  expect_error(load_config_text("mppi: 3\n", "test.yaml"), 1, "mppi", "mapping");
+}
+
+TEST(Config, OutOfRangeValuesAreRefused) {
+  expect_error(load_config_text("dcbf:\n  delta: 1.5\n", "test.yaml"), 2, "dcbf.delta",
+               "out of range");
+  expect_error(load_config_text("limits:\n  vx_max_mps: 3.5\n", "test.yaml"), 2,
+               "limits.vx_max_mps", "out of range [0, 3]");
+  expect_error(load_config_text("mppi:\n  samples: 0\n", "test.yaml"), 2, "mppi.samples",
+               "out of range");
+}
+
+TEST(Config, BadChoicesAreRefused) {
+  expect_error(load_config_text("devices:\n  base: \"can0\"\n", "test.yaml"), 2, "devices.base",
+               "socketcan:...");
+  expect_error(load_config_text("logging:\n  level: loud\n", "test.yaml"), 2, "logging.level",
+               "not one of");
+  expect_error(load_config_text("devices:\n  lidar: \"udp:\"\n", "test.yaml"), 2, "devices.lidar",
+               "not one of");
+}
+
+TEST(Config, SyntaxErrorNamesTheLine) {
+  const auto r = load_config_text("mppi:\n  samples: 10\n   lambda: [1\n", "test.yaml");
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.errors[0].file, "test.yaml");
+  EXPECT_GE(r.errors[0].line, 2);
+  EXPECT_NE(r.errors[0].message.find("YAML syntax error"), std::string::npos);
+}
+
+TEST(Config, MissingFileIsRefused) {
+  const auto r = firmware::load_config_file("/nonexistent/companiond.yaml");
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.errors[0].file, "/nonexistent/companiond.yaml");
+  EXPECT_NE(r.errors[0].message.find("cannot open"), std::string::npos);
+}
+
+TEST(Config, AllErrorsOfAFileAreReportedAtOnce) {
+  const auto r = load_config_text("mppi:\n  samples: -1\n  lamda: 1\ndcbf:\n  delta: x\n",
+                                  "test.yaml");
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.errors.size(), 3U);
+}

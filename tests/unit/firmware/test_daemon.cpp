@@ -1,0 +1,220 @@
+// companiond's task table and daemon on the simulated clock, with a real NOTIFY_SOCKET.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <thread>
+
+#include "firmware/config/config_loader.hpp"
+#include "firmware/daemon.hpp"
+#include "firmware/task_table.hpp"
+#include "hal/sim_clock.hpp"
+#include "support/notify_socket.hpp"
+
+using namespace std::chrono_literals;
+using core::Nanos;
+
+namespace {
+
+struct SimDaemon {
+  explicit SimDaemon(const firmware::DaemonConfig& cfg)
+      : daemon(cfg, notifier), executor(clock, firmware::group_table(), daemon.bindings()) {
+    daemon.attach(executor);
+    daemon.mark_initialized();
+  }
+  // Single-threaded deterministic run until `end`; `during` runs on the task thread each 10 ms
+  // (a test hook scheduled like a task, after the table's tasks).
+  void run_until(Nanos end) {
+    clock.set_horizon(end);
+    std::thread stopper([&] {
+      clock.wait_until_idle_at(end);
+      executor.stop();
+    });
+    executor.run(0s);
+    stopper.join();
+  }
+  hal::SimClock clock;
+  hal::SystemdNotifier notifier;
+  firmware::Daemon daemon;
+  firmware::Executor executor;
+};
+
+firmware::DaemonConfig defaults() { return *firmware::load_default_config().config; }
+
+}  // namespace
+
+TEST(TaskTable, HasTheRowsOfTheDesign) {
+  const auto& t = firmware::task_table();
+  auto rate = [&](std::string_view name) {
+    for (const auto& row : t) {
+      if (row.spec.name == name) return row.spec.rate_hz;
+    }
+    return 0U;
+  };
+  EXPECT_EQ(rate("tracker"), 120U);
+  EXPECT_EQ(rate("base"), 50U);
+  EXPECT_EQ(rate("lidar"), 10U);
+  EXPECT_EQ(rate("policy"), 30U);
+  EXPECT_EQ(rate("control"), 100U);
+  EXPECT_EQ(rate("supervisor"), 100U);
+  for (const auto& row : t) {
+    EXPECT_LT(row.spec.group, firmware::group_table().size());
+    EXPECT_LT(firmware::group_table()[row.spec.group].fifo_priority, 50);
+  }
+  // The 10 Hz lidar task never shares a thread with the 100 Hz control task.
+  uint8_t lidar_group = 0;
+  uint8_t control_group = 0;
+  for (const auto& row : t) {
+    if (row.spec.name == "lidar") lidar_group = row.spec.group;
+    if (row.spec.name == "control") control_group = row.spec.group;
+  }
+  EXPECT_NE(lidar_group, control_group);
+}
+
+TEST(Daemon, WithNoDevicesItHoldsBecauseTheTrackerIsSilentAndSaysSo) {
+  test_support::NotifySocket sock;
+  ASSERT_TRUE(sock.ok());
+  sock.export_env();
+  SimDaemon d(defaults());
+  d.run_until(3s);
+  unsetenv("NOTIFY_SOCKET");
+
+  const auto safety = d.daemon.safety().read();
+  ASSERT_TRUE(safety.has_value());
+  EXPECT_EQ(safety->value.state, core::SafetyState::kHold);
+  EXPECT_EQ(safety->value.reason, core::Reason::kTrackerSilent);
+  EXPECT_FALSE(safety->value.motion_allowed);
+  const auto cmd = d.daemon.command().read();
+  ASSERT_TRUE(cmd.has_value());
+  EXPECT_TRUE(cmd->value.is_zero());
+  EXPECT_EQ(cmd->count, 301U) << "the control task streamed a command every 10 ms";
+
+  const std::string status = d.daemon.status_line();
+  EXPECT_EQ(status.rfind("HOLD: tracker silent", 0), 0U) << status;
+  EXPECT_NE(status.find("control 100Hz"), std::string::npos) << status;
+  EXPECT_NE(status.find("not yet implemented: tracker, base, control, policy, lidar"),
+            std::string::npos)
+      << status;
+  const auto sent = sock.receive_containing("STATUS=HOLD: tracker silent", 1s);
+  EXPECT_TRUE(sent.has_value());
+}
+
+namespace {
+// Collects every notification while `body` runs (systemd reads promptly; so must the test, or
+// the sender blocks once the socket's small queue is full).
+template <typename F>
+std::vector<std::string> collect_notifications(F body) {
+  test_support::NotifySocket sock;
+  EXPECT_TRUE(sock.ok());
+  sock.export_env();
+  std::atomic<bool> done{false};
+  std::vector<std::string> msgs;
+  std::thread drain([&] {
+    while (!done.load()) {
+      if (auto m = sock.receive(20ms)) msgs.push_back(*m);
+    }
+    while (auto m = sock.receive(0ms)) msgs.push_back(*m);
+  });
+  body();
+  done = true;
+  drain.join();
+  unsetenv("NOTIFY_SOCKET");
+  return msgs;
+}
+
+int count(const std::vector<std::string>& msgs, const std::string& m) {
+  return static_cast<int>(std::count(msgs.begin(), msgs.end(), m));
+}
+}  // namespace
+
+TEST(Daemon, PingsTheWatchdogWhileControlRuns) {
+  setenv("WATCHDOG_USEC", "400000", 1);
+  setenv("WATCHDOG_PID", std::to_string(getpid()).c_str(), 1);
+  const auto msgs = collect_notifications([] {
+    SimDaemon d(defaults());
+    d.run_until(1s);
+  });
+  unsetenv("WATCHDOG_USEC");
+  unsetenv("WATCHDOG_PID");
+  // Every 100 ms (a quarter of WatchdogSec) over one second, while holding (control runs).
+  const int pings = count(msgs, "WATCHDOG=1");
+  EXPECT_GE(pings, 9);
+  EXPECT_LE(pings, 11);
+}
+
+TEST(Daemon, StopsPingingTheWatchdogWhenControlStalls) {
+  setenv("WATCHDOG_USEC", "400000", 1);
+  setenv("WATCHDOG_PID", std::to_string(getpid()).c_str(), 1);
+  std::vector<std::string> before;
+  std::vector<std::string> after;
+  auto cfg = defaults();
+  {
+    // The control task hangs from 1 s on (its thread "works" forever in virtual time): the
+    // supervisor must fault and the pings must stop, while other groups keep running.
+    hal::SimClock clock;
+    hal::SystemdNotifier notifier;
+    firmware::Daemon daemon(cfg, notifier);
+    auto tasks = daemon.bindings();
+    for (auto& t : tasks) {
+      if (t.spec.name == "control") {
+        auto real = t.fn;
+        t.fn = [&clock, real](const core::Tick& tick) {
+          if (tick.now >= 1s) clock.sleep_until(tick.now + 1h);
+          real(tick);
+        };
+        t.spec.group = firmware::kGroupPlanning;  // its own thread, so the supervisor runs on
+      }
+    }
+    firmware::Executor ex(clock, firmware::group_table(), tasks);
+    daemon.attach(ex);
+    daemon.mark_initialized();
+    before = collect_notifications([&] {
+      clock.set_horizon(1s);
+      ex.start(0s, false);
+      clock.wait_until_idle_at(1s);
+    });
+    after = collect_notifications([&] {
+      clock.set_horizon(3s);
+      clock.wait_until_idle_at(3s);
+      ex.stop();
+    });
+    EXPECT_EQ(daemon.safety().read()->value.state, core::SafetyState::kFault);
+    EXPECT_EQ(daemon.safety().read()->value.reason, core::Reason::kControlStalled);
+  }
+  unsetenv("WATCHDOG_USEC");
+  unsetenv("WATCHDOG_PID");
+  EXPECT_GE(count(before, "WATCHDOG=1"), 9);
+  EXPECT_LE(count(after, "WATCHDOG=1"), 2) << "at most the pings before the stall was seen";
+}
+
+TEST(Daemon, ShutdownStopsTheRobotBeforeReportingComplete) {
+  SimDaemon d(defaults());
+  bool complete_seen = false;
+  d.clock.set_horizon(1s);
+  std::thread stopper([&] {
+    d.clock.wait_until_idle_at(1s);
+    EXPECT_FALSE(d.daemon.shutdown_complete());
+    d.daemon.request_shutdown();
+    d.clock.set_horizon(1s + 50ms);
+    d.clock.wait_until_idle_at(1s + 50ms);
+    complete_seen = d.daemon.shutdown_complete();
+    d.executor.stop();
+  });
+  d.executor.run(0s);
+  stopper.join();
+  EXPECT_TRUE(complete_seen);
+  EXPECT_EQ(d.daemon.safety().read()->value.reason, core::Reason::kShutdown);
+}
+
+TEST(Daemon, SameInputsSameOutputsBitForBit) {
+  auto run = [] {
+    SimDaemon d(defaults());
+    d.run_until(2500ms);
+    const auto s = d.daemon.safety().read();
+    const auto c = d.daemon.command().read();
+    return std::make_tuple(s->count, s->stamp, static_cast<int>(s->value.reason), c->count,
+                           c->stamp, d.daemon.status_line());
+  };
+  EXPECT_EQ(run(), run());
+}
