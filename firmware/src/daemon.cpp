@@ -162,15 +162,22 @@ void Daemon::report_task(const core::Tick& tick) {
     last_runs_.assign(n, 0);
     measured_rate_hz_.assign(n, 0.0);
   }
-  if (last_report_ != core::kNever) {
-    const double dt = core::to_seconds(tick.now - last_report_);
-    for (size_t i = 0; i < n; ++i) {
-      const uint64_t runs = executor_->stats(i).runs();
-      measured_rate_hz_[i] = dt > 0 ? static_cast<double>(runs - last_runs_[i]) / dt : 0.0;
+  // Rate = runs between two reports over the time between their last starts: exact for a task
+  // on time (no +-1 run quantisation of a fixed window), lower when it skips releases.
+  if (last_starts_.size() != n) last_starts_.assign(n, core::kNever);
+  for (size_t i = 0; i < n; ++i) {
+    const core::TaskStats& st = executor_->stats(i);
+    const uint64_t runs = st.runs();
+    const Nanos start = runs > 0 ? st.last_start() : core::kNever;
+    if (last_starts_[i] != core::kNever && start != core::kNever && start > last_starts_[i]) {
+      measured_rate_hz_[i] =
+          static_cast<double>(runs - last_runs_[i]) / core::to_seconds(start - last_starts_[i]);
+    } else if (last_starts_[i] != core::kNever) {
+      measured_rate_hz_[i] = 0.0;  // no run since the previous report
     }
+    last_runs_[i] = runs;
+    last_starts_[i] = start;
   }
-  for (size_t i = 0; i < n; ++i) last_runs_[i] = executor_->stats(i).runs();
-  last_report_ = tick.now;
 
   const auto safety = safety_.read();
   std::string line = safety ? safety_text(safety->value) : std::string("INIT: starting up");

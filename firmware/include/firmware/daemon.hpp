@@ -87,7 +87,7 @@ class Daemon {
 
   // report task state
   std::vector<uint64_t> last_runs_;
-  core::Nanos last_report_ = core::kNever;
+  std::vector<core::Nanos> last_starts_;
   core::Nanos last_summary_ = core::kNever;
   std::vector<double> measured_rate_hz_;
   std::string status_;

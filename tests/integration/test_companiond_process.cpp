@@ -1,0 +1,87 @@
+// The real companiond binary, as systemd runs it: READY, STATUS, STOPPING over a real
+// NOTIFY_SOCKET, orderly stop on SIGINT/SIGTERM, refusal of bad configuration.
+#include <gtest/gtest.h>
+
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+
+#include "support/child_process.hpp"
+#include "support/notify_socket.hpp"
+
+using namespace std::chrono_literals;
+using test_support::ChildProcess;
+
+namespace {
+
+std::string write_temp(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+void run_and_stop(int sig) {
+  test_support::NotifySocket sock;
+  ASSERT_TRUE(sock.ok());
+  sock.export_env();
+  const std::string cfg = write_temp("companiond-test.yaml", "logging:\n  summary_period_s: 1\n");
+  ChildProcess p({COMPANIOND_PATH, "--config", cfg, "--log-sink", "console"});
+  unsetenv("NOTIFY_SOCKET");
+  ASSERT_TRUE(p.started());
+
+  EXPECT_TRUE(sock.receive_containing("READY=1", 10s).has_value());
+  const auto status = sock.receive_containing("STATUS=HOLD: tracker silent", 10s);
+  ASSERT_TRUE(status.has_value()) << p.output();
+  EXPECT_NE(status->find("control 100Hz"), std::string::npos) << *status;
+
+  p.signal(sig);
+  EXPECT_TRUE(sock.receive_containing("STOPPING=1", 5s).has_value());
+  const auto code = p.wait(10s);
+  ASSERT_TRUE(code.has_value()) << "companiond did not exit after the signal";
+  EXPECT_EQ(*code, 0);
+  const std::string out = p.output();
+  // It says plainly why it holds, and that it stopped the robot before leaving.
+  EXPECT_NE(out.find("HOLD: tracker silent"), std::string::npos) << out;
+  EXPECT_NE(out.find("zero velocity commanded; exiting"), std::string::npos) << out;
+}
+
+}  // namespace
+
+TEST(Companiond, StartsHoldsAndStopsOnSigint) { run_and_stop(SIGINT); }
+
+TEST(Companiond, StopsOnSigterm) { run_and_stop(SIGTERM); }
+
+TEST(Companiond, RefusesABadConfigNamingFileLineAndKey) {
+  const std::string cfg = write_temp("bad.yaml", "mppi:\n  samples: 10\n  lamda: 1\n");
+  ChildProcess p({COMPANIOND_PATH, "--config", cfg});
+  ASSERT_TRUE(p.started());
+  const auto code = p.wait(10s);
+  ASSERT_TRUE(code.has_value());
+  EXPECT_EQ(*code, 2);
+  EXPECT_NE(p.output().find(cfg + ":3: 'mppi.lamda': unknown key"), std::string::npos)
+      << p.output();
+}
+
+TEST(Companiond, CheckConfigAcceptsTheShippedDefaults) {
+  ChildProcess p({COMPANIOND_PATH, "--check-config", COMPANION_DEFAULT_CONFIG});
+  ASSERT_TRUE(p.started());
+  EXPECT_EQ(p.wait(10s), 0);
+  EXPECT_NE(p.output().find(": OK"), std::string::npos);
+}
+
+TEST(Companiond, CheckConfigRejectsAMissingFile) {
+  ChildProcess p({COMPANIOND_PATH, "--check-config", "/nonexistent.yaml"});
+  ASSERT_TRUE(p.started());
+  EXPECT_EQ(p.wait(10s), 2);
+  EXPECT_NE(p.output().find("/nonexistent.yaml: cannot open"), std::string::npos) << p.output();
+}
+
+TEST(Companiond, PrintConfigShowsEffectiveValues) {
+  const std::string cfg = write_temp("print.yaml", "mppi:\n  samples: 777\n");
+  ChildProcess p({COMPANIOND_PATH, "--config", cfg, "--print-config"});
+  ASSERT_TRUE(p.started());
+  EXPECT_EQ(p.wait(10s), 0);
+  const std::string out = p.output();
+  EXPECT_NE(out.find("samples: 777"), std::string::npos) << out;
+  EXPECT_NE(out.find("horizon_steps: 100"), std::string::npos) << out;
+}
