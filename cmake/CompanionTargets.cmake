@@ -3,7 +3,7 @@ add_library(companion_options INTERFACE)
 target_compile_options(companion_options INTERFACE
   -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wno-sign-conversion
   -Wnon-virtual-dtor -Wold-style-cast -Wcast-align -Woverloaded-virtual
-  -Wnull-dereference -Wdouble-promotion -Wformat=2 -Wimplicit-fallthrough)
+  -Wdouble-promotion -Wformat=2 -Wimplicit-fallthrough)
 if(COMPANION_WERROR)
   target_compile_options(companion_options INTERFACE -Werror)
 endif()

@@ -2,10 +2,11 @@
 // Timestamped latest-value channel between tasks: exactly one writer task, any number of
 // readers, never blocks, never tears.
 //
-// A sequence lock over storage made of relaxed atomic words: the writer makes the sequence odd,
-// stores the words, makes it even; a reader retries when the sequence was odd or changed under
-// it. All shared accesses are atomic, so there is no data race in the C++ model (ThreadSanitizer
-// agrees), and T only has to be trivially copyable. Large values (costmaps) use double buffers
+// A sequence lock over storage made of atomic words: the writer makes the sequence odd, stores
+// the words (release), makes it even; a reader loads the words (acquire) and retries when the
+// sequence was odd or changed under it. All shared accesses are atomic and ordered without
+// fences, so there is no data race in the C++ model and ThreadSanitizer can check it; T only has
+// to be trivially copyable. Large values (costmaps) use double buffers
 // of their own instead of this.
 #include <array>
 #include <atomic>
@@ -40,8 +41,8 @@ class LatestValue {
     std::memcpy(words.data(), &p, sizeof(Payload));
     const uint64_t seq = seq_.load(std::memory_order_relaxed);
     seq_.store(seq + 1, std::memory_order_relaxed);
-    std::atomic_thread_fence(std::memory_order_release);
-    for (size_t i = 0; i < kWords; ++i) words_[i].store(words[i], std::memory_order_relaxed);
+    // Release stores: a reader that sees any new word also sees the odd sequence before it.
+    for (size_t i = 0; i < kWords; ++i) words_[i].store(words[i], std::memory_order_release);
     seq_.store(seq + 2, std::memory_order_release);
   }
 
@@ -52,8 +53,8 @@ class LatestValue {
       const uint64_t s1 = seq_.load(std::memory_order_acquire);
       if (s1 == 0) return std::nullopt;
       if (s1 & 1U) continue;  // write in progress
-      for (size_t i = 0; i < kWords; ++i) words[i] = words_[i].load(std::memory_order_relaxed);
-      std::atomic_thread_fence(std::memory_order_acquire);
+      // Acquire loads keep the re-check of the sequence after them.
+      for (size_t i = 0; i < kWords; ++i) words[i] = words_[i].load(std::memory_order_acquire);
       if (seq_.load(std::memory_order_relaxed) == s1) break;
     }
     Payload p;
