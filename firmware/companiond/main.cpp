@@ -1,9 +1,9 @@
 // companiond: the companion robot daemon. Loads and validates the configuration, sets up
 // real-time scheduling, runs the task table until SIGTERM/SIGINT, then stops the robot before
 // exiting. See README.md ("Deploy on the robot", "Diagnose").
-#include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include <CLI/CLI.hpp>
 #include <csignal>
 #include <cstdio>
 #include <iostream>
@@ -19,7 +19,8 @@
 namespace {
 
 int print_errors(const std::vector<firmware::ConfigError>& errors) {
-  for (const auto& e : errors) std::cerr << "config error: " << e.to_string() << "\n";
+  for (const auto& e : errors)
+    std::cerr << "config error: " << e.to_string() << "\n";
   return 2;
 }
 
@@ -79,8 +80,8 @@ int main(int argc, char** argv) {
                config_path.empty() ? std::string("built-in defaults") : config_path);
   for (const auto& row : firmware::task_table()) {
     spdlog::info("task {:<10} {:>4} Hz budget {:>5} us group {} prio {}{}", row.spec.name,
-                 row.spec.rate_hz, row.spec.budget_us,
-                 firmware::group_table()[row.spec.group].name, row.spec.priority,
+                 row.spec.rate_hz, row.spec.budget_us, firmware::group_table()[row.spec.group].name,
+                 row.spec.priority,
                  row.pending.empty() ? std::string()
                                      : " - not yet implemented: " + std::string(row.pending));
   }
@@ -122,17 +123,19 @@ int main(int argc, char** argv) {
     }
     if (!failed.empty() || !mem.ok) {
       if (cfg.realtime.require) {
-        spdlog::critical("realtime.require is set but real-time scheduling is not permitted "
-                         "(groups: {}): {}",
-                         failed, why);
+        spdlog::critical(
+            "realtime.require is set but real-time scheduling is not permitted "
+            "(groups: {}): {}",
+            failed, why);
         executor.stop();
         firmware::shutdown_logging();
         return 1;
       }
-      spdlog::warn("running WITHOUT real-time guarantees: {}{} - deadlines may be missed under "
-                   "load (grant CAP_SYS_NICE and CAP_IPC_LOCK, as the systemd unit does)",
-                   failed.empty() ? "" : "SCHED_FIFO refused for " + failed + ": " + why,
-                   mem.ok ? "" : (failed.empty() ? "" : "; ") + mem.message);
+      spdlog::warn(
+          "running WITHOUT real-time guarantees: {}{} - deadlines may be missed under "
+          "load (grant CAP_SYS_NICE and CAP_IPC_LOCK, as the systemd unit does)",
+          failed.empty() ? "" : "SCHED_FIFO refused for " + failed + ": " + why,
+          mem.ok ? "" : (failed.empty() ? "" : "; ") + mem.message);
     } else {
       spdlog::info("real-time: memory locked, SCHED_FIFO rate-group threads");
     }

@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+#include <limits>
+
 #include "firmware/task_table.hpp"
 
 namespace firmware {
@@ -160,7 +163,7 @@ void Daemon::report_task(const core::Tick& tick) {
   const size_t n = executor_->task_count();
   if (last_runs_.size() != n) {
     last_runs_.assign(n, 0);
-    measured_rate_hz_.assign(n, 0.0);
+    measured_rate_hz_.assign(n, std::numeric_limits<double>::quiet_NaN());
   }
   // Rate = runs between two reports over the time between their last starts: exact for a task
   // on time (no +-1 run quantisation of a fixed window), lower when it skips releases.
@@ -174,6 +177,8 @@ void Daemon::report_task(const core::Tick& tick) {
           static_cast<double>(runs - last_runs_[i]) / core::to_seconds(start - last_starts_[i]);
     } else if (last_starts_[i] != core::kNever) {
       measured_rate_hz_[i] = 0.0;  // no run since the previous report
+    } else {
+      measured_rate_hz_[i] = std::numeric_limits<double>::quiet_NaN();  // not measured yet
     }
     last_runs_[i] = runs;
     last_starts_[i] = start;
@@ -185,7 +190,9 @@ void Daemon::report_task(const core::Tick& tick) {
   std::string shells;
   for (size_t i = 0; i < n; ++i) {
     const auto& spec = executor_->spec(i);
-    rates += fmt::format("{}{} {:.0f}Hz", rates.empty() ? "" : " ", spec.name, measured_rate_hz_[i]);
+    const double hz = measured_rate_hz_[i];
+    rates += std::isnan(hz) ? fmt::format("{}{} -Hz", rates.empty() ? "" : " ", spec.name)
+                            : fmt::format("{}{} {:.0f}Hz", rates.empty() ? "" : " ", spec.name, hz);
     for (const TaskRow& row : task_table()) {
       if (row.spec.name == spec.name && !row.pending.empty()) {
         shells += fmt::format("{}{}", shells.empty() ? "" : ", ", spec.name);
@@ -200,8 +207,8 @@ void Daemon::report_task(const core::Tick& tick) {
     last_status_sent_ = status_;
   }
 
-  const Nanos summary_every =
-      std::chrono::duration_cast<Nanos>(std::chrono::duration<double>(cfg_.logging.summary_period_s));
+  const Nanos summary_every = std::chrono::duration_cast<Nanos>(
+      std::chrono::duration<double>(cfg_.logging.summary_period_s));
   if (last_summary_ == core::kNever || tick.now - last_summary_ >= summary_every) {
     spdlog::info("status: {}", status_);
     spdlog::info("timing: {}", timing_summary());
@@ -209,21 +216,26 @@ void Daemon::report_task(const core::Tick& tick) {
   }
 }
 
-std::string Daemon::status_line() const { return status_; }
+std::string Daemon::status_line() const {
+  return status_;
+}
 
 std::string Daemon::timing_summary() const {
   if (executor_ == nullptr) return {};
   std::string out;
   for (size_t i = 0; i < executor_->task_count(); ++i) {
     const auto& st = executor_->stats(i);
-    const double rate = i < measured_rate_hz_.size() ? measured_rate_hz_[i] : 0.0;
+    const double rate = i < measured_rate_hz_.size() ? measured_rate_hz_[i]
+                                                     : std::numeric_limits<double>::quiet_NaN();
     out += fmt::format(
-        "{}{} {:.1f}Hz jitter p50/p99/max {:.0f}/{:.0f}/{:.0f}us run p99/max {:.0f}/{:.0f}us "
+        "{}{} {}Hz jitter p50/p99/max {:.0f}/{:.0f}/{:.0f}us run p99/max {:.0f}/{:.0f}us "
         "over {} skip {} budget {}",
-        out.empty() ? "" : "; ", executor_->spec(i).name, rate,
-        core::to_us(st.period_jitter().quantile(0.5)), core::to_us(st.period_jitter().quantile(0.99)),
-        core::to_us(st.period_jitter().max()), core::to_us(st.run_time().quantile(0.99)),
-        core::to_us(st.run_time().max()), st.overruns(), st.skipped(), st.budget_exceeded());
+        out.empty() ? "" : "; ", executor_->spec(i).name,
+        std::isnan(rate) ? std::string("-") : fmt::format("{:.1f}", rate),
+        core::to_us(st.period_jitter().quantile(0.5)),
+        core::to_us(st.period_jitter().quantile(0.99)), core::to_us(st.period_jitter().max()),
+        core::to_us(st.run_time().quantile(0.99)), core::to_us(st.run_time().max()), st.overruns(),
+        st.skipped(), st.budget_exceeded());
   }
   return out;
 }

@@ -18,8 +18,10 @@ const std::array<core::GroupSpec, 4>& group_table() {
 // COMPANION_TASK(name, rate_hz, budget_us, group, priority, pending)
 //   priority orders tasks due at the same instant within a group (and in single-thread mode):
 //   fresh inputs first, then the supervisor's judgement, then the control output it gates.
-#define COMPANION_TASK(name, rate_hz, budget_us, group, priority, pending) \
-  TaskRow { core::TaskSpec{#name, rate_hz, budget_us, group, priority}, &Daemon::name##_task, pending }
+#define COMPANION_TASK(name, rate_hz, budget_us, group, priority, pending)                    \
+  TaskRow {                                                                                   \
+    core::TaskSpec{#name, rate_hz, budget_us, group, priority}, &Daemon::name##_task, pending \
+  }
 
 const std::array<TaskRow, 8>& task_table() {
   static const std::array<TaskRow, 8> kTable{{

@@ -22,7 +22,9 @@ Nanos monotonic_now() {
   return Nanos(static_cast<int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec);
 }
 
-Nanos LinuxClock::now() const { return monotonic_now(); }
+Nanos LinuxClock::now() const {
+  return monotonic_now();
+}
 
 bool LinuxClock::sleep_until(Nanos deadline) {
   // Sleep in slices no longer than kMaxSleepSlice so a stop request is seen promptly; each slice

@@ -15,8 +15,9 @@ RtResult failure(const char* what, int err) {
   r.error_number = err;
   r.message = std::string(what) + ": " + std::strerror(err);
   if (err == EPERM) {
-    r.message += " (needs CAP_SYS_NICE / CAP_IPC_LOCK or an rtprio/memlock limit; "
-                 "the systemd unit grants them)";
+    r.message +=
+        " (needs CAP_SYS_NICE / CAP_IPC_LOCK or an rtprio/memlock limit; "
+        "the systemd unit grants them)";
   }
   return r;
 }

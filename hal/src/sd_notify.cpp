@@ -8,7 +8,9 @@
 
 namespace hal {
 
-bool SystemdNotifier::enabled() const { return std::getenv("NOTIFY_SOCKET") != nullptr; }
+bool SystemdNotifier::enabled() const {
+  return std::getenv("NOTIFY_SOCKET") != nullptr;
+}
 
 bool SystemdNotifier::send(std::string_view message) {
   if (!enabled()) return false;
@@ -16,20 +18,28 @@ bool SystemdNotifier::send(std::string_view message) {
   return sd_notify(0, msg.c_str()) > 0;
 }
 
-bool SystemdNotifier::ready() { return send("READY=1"); }
-bool SystemdNotifier::watchdog() { return send("WATCHDOG=1"); }
-bool SystemdNotifier::stopping() { return send("STOPPING=1"); }
+bool SystemdNotifier::ready() {
+  return send("READY=1");
+}
+bool SystemdNotifier::watchdog() {
+  return send("WATCHDOG=1");
+}
+bool SystemdNotifier::stopping() {
+  return send("STOPPING=1");
+}
 
 bool SystemdNotifier::status(std::string_view line) {
   std::string msg = "STATUS=";
   // STATUS is one line: newlines would end the assignment early.
-  for (const char c : line) msg.push_back(c == '\n' ? ' ' : c);
+  for (const char c : line)
+    msg.push_back(c == '\n' ? ' ' : c);
   return send(msg);
 }
 
 bool SystemdNotifier::ready_with_status(std::string_view line) {
   std::string msg = "READY=1\nSTATUS=";
-  for (const char c : line) msg.push_back(c == '\n' ? ' ' : c);
+  for (const char c : line)
+    msg.push_back(c == '\n' ? ' ' : c);
   return send(msg);
 }
 

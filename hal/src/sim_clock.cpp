@@ -74,8 +74,7 @@ void SimClock::set_horizon(Nanos horizon) {
 bool SimClock::wait_until_idle_at(Nanos t) {
   std::unique_lock lock(mutex_);
   cv_.wait(lock, [&] {
-    return interrupted_ ||
-           (now_ >= t && static_cast<int>(pending_.size()) >= attached_);
+    return interrupted_ || (now_ >= t && static_cast<int>(pending_.size()) >= attached_);
   });
   return !interrupted_;
 }

@@ -53,8 +53,10 @@ BENCHMARK(BM_TaskStatsRecord);
 
 void BM_HistogramQuantile(benchmark::State& state) {
   core::DurationHistogram h;
-  for (int i = 0; i < 100000; ++i) h.record(core::Nanos(i * 37 % 1000000));
-  for (auto _ : state) benchmark::DoNotOptimize(h.quantile(0.99));
+  for (int i = 0; i < 100000; ++i)
+    h.record(core::Nanos(i * 37 % 1000000));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(h.quantile(0.99));
 }
 BENCHMARK(BM_HistogramQuantile);
 

@@ -4,9 +4,9 @@
 // threaded rate groups and, as the baseline in the same invocation, the single-thread mode.
 //
 //   build/release/tests/bench/bench_scheduler --duration-s 20 --lidar-work-ms 60
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <map>
 
@@ -41,15 +41,16 @@ void print_stats(const firmware::Executor& ex, double seconds) {
               "skip");
   for (size_t i = 0; i < ex.task_count(); ++i) {
     const auto& s = ex.stats(i);
-    std::printf("  %-10s %5u %8llu | %6.0f / %6.0f / %6.0f us | %6.0f / %6.0f us | %6.0f / %6.0f | %5llu %5llu\n",
-                std::string(ex.spec(i).name).c_str(), ex.spec(i).rate_hz,
-                static_cast<unsigned long long>(s.runs()),
-                core::to_us(s.period_jitter().quantile(0.5)),
-                core::to_us(s.period_jitter().quantile(0.99)), core::to_us(s.period_jitter().max()),
-                core::to_us(s.start_latency().quantile(0.99)), core::to_us(s.start_latency().max()),
-                core::to_us(s.run_time().quantile(0.5)), core::to_us(s.run_time().quantile(0.99)),
-                static_cast<unsigned long long>(s.overruns()),
-                static_cast<unsigned long long>(s.skipped()));
+    std::printf(
+        "  %-10s %5u %8llu | %6.0f / %6.0f / %6.0f us | %6.0f / %6.0f us | %6.0f / %6.0f | %5llu "
+        "%5llu\n",
+        std::string(ex.spec(i).name).c_str(), ex.spec(i).rate_hz,
+        static_cast<unsigned long long>(s.runs()), core::to_us(s.period_jitter().quantile(0.5)),
+        core::to_us(s.period_jitter().quantile(0.99)), core::to_us(s.period_jitter().max()),
+        core::to_us(s.start_latency().quantile(0.99)), core::to_us(s.start_latency().max()),
+        core::to_us(s.run_time().quantile(0.5)), core::to_us(s.run_time().quantile(0.99)),
+        static_cast<unsigned long long>(s.overruns()),
+        static_cast<unsigned long long>(s.skipped()));
   }
   (void)seconds;
 }
@@ -79,10 +80,12 @@ int main(int argc, char** argv) {
       {"policy", std::chrono::microseconds(200)},
       {"lidar", std::chrono::microseconds(static_cast<int64_t>(lidar_work_ms * 1000))},
   };
-  std::printf("work per run: tracker 50 us, base 50 us, supervisor 10 us, control %.1f ms, "
-              "policy 200 us, lidar %.1f ms; %.0f s per mode\n",
-              control_work_ms, lidar_work_ms, duration_s);
-  const Nanos duration = std::chrono::duration_cast<Nanos>(std::chrono::duration<double>(duration_s));
+  std::printf(
+      "work per run: tracker 50 us, base 50 us, supervisor 10 us, control %.1f ms, "
+      "policy 200 us, lidar %.1f ms; %.0f s per mode\n",
+      control_work_ms, lidar_work_ms, duration_s);
+  const Nanos duration =
+      std::chrono::duration_cast<Nanos>(std::chrono::duration<double>(duration_s));
 
   if (mode == "threaded" || mode == "both") {
     hal::LinuxClock clock;

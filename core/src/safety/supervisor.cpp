@@ -16,10 +16,14 @@ double age_ms(Nanos stamp, Nanos now) {
 
 const char* confidence_name(TrackerConfidence c) {
   switch (c) {
-    case TrackerConfidence::kGood: return "GOOD";
-    case TrackerConfidence::kDegraded: return "DEGRADED";
-    case TrackerConfidence::kBad: return "BAD";
-    case TrackerConfidence::kUnknown: break;
+    case TrackerConfidence::kGood:
+      return "GOOD";
+    case TrackerConfidence::kDegraded:
+      return "DEGRADED";
+    case TrackerConfidence::kBad:
+      return "BAD";
+    case TrackerConfidence::kUnknown:
+      break;
   }
   return "UNKNOWN";
 }
@@ -71,7 +75,8 @@ ReasonSet Supervisor::evaluate(const SafetyInputs& in, Nanos now) {
 
   // Counters: a new error since the previous update trips the condition (cleared by hysteresis).
   if (counters_seen_) {
-    if (config_.require_base) set(Reason::kCanWriteErrors, in.can_write_errors > last_write_errors_);
+    if (config_.require_base)
+      set(Reason::kCanWriteErrors, in.can_write_errors > last_write_errors_);
     set(Reason::kControlOverrun, in.control_overruns > last_overruns_);
   }
   counters_seen_ = true;
@@ -83,7 +88,8 @@ ReasonSet Supervisor::evaluate(const SafetyInputs& in, Nanos now) {
   set(Reason::kNumericalFailure, in.numerical_failure);
 
   ReasonSet active;
-  for (size_t i = 0; i < kReasonCount; ++i) active[i] = debounce_[i].update(raw[i], now);
+  for (size_t i = 0; i < kReasonCount; ++i)
+    active[i] = debounce_[i].update(raw[i], now);
   return active;
 }
 
@@ -100,8 +106,8 @@ void Supervisor::describe(const SafetyInputs& in, Nanos now, Reason r,
   const size_t n = out.size();
   switch (r) {
     case Reason::kTrackerSilent:
-      std::snprintf(buf, n, "tracker age %.1f ms > timeout %.1f ms",
-                    age_ms(in.tracker_stamp, now), to_ms(config_.tracker_timeout));
+      std::snprintf(buf, n, "tracker age %.1f ms > timeout %.1f ms", age_ms(in.tracker_stamp, now),
+                    to_ms(config_.tracker_timeout));
       break;
     case Reason::kTrackerConfidenceLow:
       std::snprintf(buf, n, "tracker confidence %s, age %.1f ms",
@@ -139,8 +145,7 @@ void Supervisor::describe(const SafetyInputs& in, Nanos now, Reason r,
                     age_ms(in.control_heartbeat, now), to_ms(config_.control_stall_timeout));
       break;
     default:
-      std::snprintf(buf, n, "%.*s", static_cast<int>(reason_text(r).size()),
-                    reason_text(r).data());
+      std::snprintf(buf, n, "%.*s", static_cast<int>(reason_text(r).size()), reason_text(r).data());
       break;
   }
 }
@@ -208,7 +213,8 @@ SupervisorOutput Supervisor::update(const SafetyInputs& in, Nanos now) {
   out.reason = reason_;
   out.active = active;
   out.motion_allowed = state_ == SafetyState::kActive;
-  out.watchdog_ok = in.initialized && !stale(in.control_heartbeat, now, config_.control_stall_timeout);
+  out.watchdog_ok =
+      in.initialized && !stale(in.control_heartbeat, now, config_.control_stall_timeout);
   if (state_ != prev_state || reason_ != prev_reason) {
     out.transitioned = true;
     out.transition.from = prev_state;

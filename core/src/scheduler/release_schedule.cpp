@@ -26,8 +26,10 @@ ReleaseSchedule::Claim ReleaseSchedule::claim(Nanos start) {
     const uint64_t whole_s = elapsed / kNsPerS;
     const uint64_t rem_ns = elapsed % kNsPerS;
     uint64_t estimate = whole_s * rate_hz_ + rem_ns * rate_hz_ / kNsPerS;
-    while (estimate > 0 && release_at(estimate) > start) --estimate;
-    while (release_at(estimate + 1) <= start) ++estimate;
+    while (estimate > 0 && release_at(estimate) > start)
+      --estimate;
+    while (release_at(estimate + 1) <= start)
+      ++estimate;
     k = std::max(k, estimate);
   }
   Claim c{release_at(next_k_), release_at(k), k - next_k_, release_at(k + 1)};

@@ -33,14 +33,16 @@ void DurationHistogram::record(Nanos value) {
 }
 
 void DurationHistogram::reset() {
-  for (auto& b : buckets_) b.store(0, std::memory_order_relaxed);
+  for (auto& b : buckets_)
+    b.store(0, std::memory_order_relaxed);
   count_.store(0, std::memory_order_relaxed);
   max_ns_.store(0, std::memory_order_relaxed);
 }
 
 Nanos DurationHistogram::quantile(double q) const {
   uint64_t total = 0;
-  for (const auto& b : buckets_) total += b.load(std::memory_order_relaxed);
+  for (const auto& b : buckets_)
+    total += b.load(std::memory_order_relaxed);
   if (total == 0) return Nanos(0);
   q = std::clamp(q, 0.0, 1.0);
   const auto rank =

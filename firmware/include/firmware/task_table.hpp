@@ -20,7 +20,12 @@ struct TaskRow {
 };
 
 // Rate groups: one thread each in real-time mode.
-enum Group : uint8_t { kGroupRealtime = 0, kGroupPlanning = 1, kGroupPerception = 2, kGroupReport = 3 };
+enum Group : uint8_t {
+  kGroupRealtime = 0,
+  kGroupPlanning = 1,
+  kGroupPerception = 2,
+  kGroupReport = 3
+};
 
 const std::array<core::GroupSpec, 4>& group_table();
 const std::array<TaskRow, 8>& task_table();

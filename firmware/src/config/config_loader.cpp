@@ -19,7 +19,8 @@ using config_schema::FieldSpec;
 const std::map<std::string_view, const FieldSpec*>& field_index() {
   static const auto kIndex = [] {
     std::map<std::string_view, const FieldSpec*> m;
-    for (const auto& f : config_schema::fields()) m.emplace(f.key, &f);
+    for (const auto& f : config_schema::fields())
+      m.emplace(f.key, &f);
     return m;
   }();
   return kIndex;
@@ -46,8 +47,9 @@ class Loader {
 
   void walk(const YAML::Node& node, const std::string& prefix) {
     if (!node.IsMap()) {
-      error(node, prefix, prefix.empty() ? "top level must be a mapping of sections"
-                                          : "expected a mapping (section) here");
+      error(node, prefix,
+            prefix.empty() ? "top level must be a mapping of sections"
+                           : "expected a mapping (section) here");
       return;
     }
     std::set<std::string> keys_here;
@@ -83,8 +85,10 @@ class Loader {
 
   void assign(const FieldSpec& f, const YAML::Node& v, const std::string& path) {
     if (!v.IsScalar()) {
-      error(v, path, "expected a single value, got a " +
-                         std::string(v.IsMap() ? "mapping" : v.IsSequence() ? "list" : "null"));
+      error(v, path,
+            "expected a single value, got a " + std::string(v.IsMap()        ? "mapping"
+                                                            : v.IsSequence() ? "list"
+                                                                             : "null"));
       return;
     }
     if (seen_ != nullptr) seen_->insert(path);
@@ -95,8 +99,9 @@ class Loader {
       if (!YAML::convert<double>::decode(v, x) || !std::isfinite(x)) {
         error(v, path, "expected a finite number, got '" + text + "'");
       } else if (x < f.min || x > f.max) {
-        error(v, path, "value " + text + " out of range [" + fmt_number(f.min) + ", " +
-                           fmt_number(f.max) + "] " + std::string(f.unit));
+        error(v, path,
+              "value " + text + " out of range [" + fmt_number(f.min) + ", " + fmt_number(f.max) +
+                  "] " + std::string(f.unit));
       } else {
         **d = x;
       }
@@ -105,8 +110,9 @@ class Loader {
       if (!YAML::convert<int64_t>::decode(v, x)) {
         error(v, path, "expected an integer, got '" + text + "'");
       } else if (static_cast<double>(x) < f.min || static_cast<double>(x) > f.max) {
-        error(v, path, "value " + text + " out of range [" + fmt_number(f.min) + ", " +
-                           fmt_number(f.max) + "] " + std::string(f.unit));
+        error(v, path,
+              "value " + text + " out of range [" + fmt_number(f.min) + ", " + fmt_number(f.max) +
+                  "] " + std::string(f.unit));
       } else {
         **i = x;
       }
@@ -128,7 +134,8 @@ class Loader {
       }
       if (!allowed) {
         std::string list;
-        for (const auto c : f.choices) list += (list.empty() ? "" : ", ") + std::string(c) + (c.back() == ':' ? "..." : "");
+        for (const auto c : f.choices)
+          list += (list.empty() ? "" : ", ") + std::string(c) + (c.back() == ':' ? "..." : "");
         error(v, path, "'" + text + "' is not one of: " + list);
       } else {
         **s = text;
@@ -246,7 +253,8 @@ std::string config_reference_markdown() {
   os << "# companiond configuration reference\n\n"
      << "Generated from the schema in `firmware/src/config/schema.cpp` by\n"
      << "`companiond --config-reference`; a unit test fails when this file is out of date.\n"
-     << "Defaults are in `config/companiond.yaml` (installed as `/etc/companion/companiond.yaml`).\n"
+     << "Defaults are in `config/companiond.yaml` (installed as "
+        "`/etc/companion/companiond.yaml`).\n"
      << "A configuration file may set any subset of keys; the rest keep their defaults.\n"
      << "Unknown keys, duplicate keys, wrong types and out-of-range values refuse to load\n"
      << "with the file, line and key named. Check a file with `companiond --check-config FILE`.\n\n"
@@ -256,7 +264,8 @@ std::string config_reference_markdown() {
   for (const auto& f : config_schema::fields()) {
     const std::string sec(f.key.substr(0, f.key.find('.')));
     if (sec != section) {
-      os << "\n## " << sec << "\n\n| key | unit | default | allowed | meaning |\n|---|---|---|---|---|\n";
+      os << "\n## " << sec
+         << "\n\n| key | unit | default | allowed | meaning |\n|---|---|---|---|---|\n";
       section = sec;
     }
     std::string def;

@@ -18,7 +18,9 @@ Executor::Executor(hal::Clock& clock, std::span<const core::GroupSpec> groups,
   }
 }
 
-Executor::~Executor() { stop(); }
+Executor::~Executor() {
+  stop();
+}
 
 size_t Executor::find(std::string_view name) const {
   for (size_t i = 0; i < tasks_.size(); ++i) {
@@ -35,12 +37,14 @@ void Executor::run_loop(std::span<const size_t> task_indices, core::Nanos origin
   });
   std::vector<core::ReleaseSchedule> schedules;
   schedules.reserve(order.size());
-  for (const size_t i : order) schedules.emplace_back(tasks_[i].spec.rate_hz, origin);
+  for (const size_t i : order)
+    schedules.emplace_back(tasks_[i].spec.rate_hz, origin);
   std::vector<core::Nanos> last_start(order.size(), core::Nanos(-1));
 
   while (!stop_requested()) {
     core::Nanos next = schedules[0].next_release();
-    for (const auto& s : schedules) next = std::min(next, s.next_release());
+    for (const auto& s : schedules)
+      next = std::min(next, s.next_release());
     if (!clock_.sleep_until(next)) break;
 
     // Run what is due, best first; time moves while tasks run, so look again after each one.
@@ -59,34 +63,35 @@ void Executor::run_loop(std::span<const size_t> task_indices, core::Nanos origin
       const size_t task = order[pick];
       const core::Nanos start = clock_.now();
       const core::ReleaseSchedule::Claim claim = schedules[pick].claim(start);
-      const core::Nanos period =
-          last_start[pick] < core::Nanos(0) ? schedules[pick].nominal_period()
-                                            : start - last_start[pick];
+      const core::Nanos period = last_start[pick] < core::Nanos(0)
+                                     ? schedules[pick].nominal_period()
+                                     : start - last_start[pick];
       last_start[pick] = start;
       tasks_[task].fn(core::Tick{start, period, claim.release});
       const core::Nanos end = clock_.now();
-      stats_[task]->record(core::TaskTiming{claim.first_due, claim.release, start, end, claim.following,
-                                            claim.skipped});
+      stats_[task]->record(core::TaskTiming{claim.first_due, claim.release, start, end,
+                                            claim.following, claim.skipped});
     }
   }
 }
 
 void Executor::start(core::Nanos origin, bool realtime) {
   stop_.store(false, std::memory_order_release);
-  std::latch ready(static_cast<std::ptrdiff_t>(groups_.size()));
+  std::vector<std::pair<size_t, std::vector<size_t>>> plan;  // group -> its tasks
   for (size_t g = 0; g < groups_.size(); ++g) {
     std::vector<size_t> members;
     for (size_t i = 0; i < tasks_.size(); ++i) {
       if (tasks_[i].spec.group == g) members.push_back(i);
     }
-    if (members.empty()) {
-      ready.count_down();
-      continue;
-    }
-    // Attach on the thread's behalf before it exists, so a simulated clock never advances
-    // while some group thread has not reached its first sleep yet.
+    if (!members.empty()) plan.emplace_back(g, std::move(members));
+  }
+  // Attach every thread before the first one exists, so a simulated clock cannot advance while
+  // some group thread has not reached its first sleep yet.
+  for (size_t k = 0; k < plan.size(); ++k)
     clock_.attach_thread();
-    threads_.emplace_back([this, g, members = std::move(members), origin, realtime, &ready] {
+  std::latch ready(static_cast<std::ptrdiff_t>(plan.size()));
+  for (auto& [g, members] : plan) {
+    threads_.emplace_back([this, g = g, members = std::move(members), origin, realtime, &ready] {
       const core::GroupSpec& group = groups_[g];
       hal::set_current_thread_name(std::string("cmp-") + std::string(group.name));
       if (realtime && group.fifo_priority > 0) {

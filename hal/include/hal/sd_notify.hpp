@@ -12,10 +12,10 @@ class SystemdNotifier {
   // True when NOTIFY_SOCKET is set, i.e. systemd (or a test) listens.
   [[nodiscard]] bool enabled() const;
 
-  bool ready();                          // READY=1
-  bool watchdog();                       // WATCHDOG=1
-  bool status(std::string_view line);    // STATUS=<line>
-  bool stopping();                       // STOPPING=1
+  bool ready();                        // READY=1
+  bool watchdog();                     // WATCHDOG=1
+  bool status(std::string_view line);  // STATUS=<line>
+  bool stopping();                     // STOPPING=1
   bool ready_with_status(std::string_view line);
 
   // WatchdogSec of the unit (from WATCHDOG_USEC / WATCHDOG_PID), if the watchdog is enabled

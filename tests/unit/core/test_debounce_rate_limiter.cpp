@@ -20,7 +20,8 @@ TEST(Debounce, AssertsAtOnceAndClearsAfterStayingClear) {
 TEST(RateLimiter, EmitsOncePerIntervalAndCountsTheRest) {
   core::RateLimiter r(1s);
   EXPECT_TRUE(r.check(0ms).emit);
-  for (int i = 1; i < 100; ++i) EXPECT_FALSE(r.check(i * 10ms).emit);
+  for (int i = 1; i < 100; ++i)
+    EXPECT_FALSE(r.check(i * 10ms).emit);
   const auto d = r.check(1000ms);
   EXPECT_TRUE(d.emit);
   EXPECT_EQ(d.suppressed, 99U);

@@ -30,11 +30,14 @@ TEST(Histogram, QuantilesOfAKnownDistribution) {
   std::vector<int64_t> values;
   std::mt19937 rng(42);
   std::uniform_int_distribution<int64_t> dist(1000, 2'000'000);
-  for (int i = 0; i < 20000; ++i) values.push_back(dist(rng));
-  for (const auto v : values) h.record(Nanos(v));
+  for (int i = 0; i < 20000; ++i)
+    values.push_back(dist(rng));
+  for (const auto v : values)
+    h.record(Nanos(v));
   std::sort(values.begin(), values.end());
   for (const double q : {0.5, 0.9, 0.99}) {
-    const auto exact = static_cast<double>(values[static_cast<size_t>(q * static_cast<double>(values.size())) - 1]);
+    const auto exact = static_cast<double>(
+        values[static_cast<size_t>(q * static_cast<double>(values.size())) - 1]);
     const auto got = static_cast<double>(h.quantile(q).count());
     EXPECT_GE(got, exact * 0.999) << q;
     EXPECT_LE(got, exact * 1.04) << q;

@@ -67,12 +67,14 @@ TEST(LatestValue, ConcurrentReadersNeverSeeATornValue) {
     });
   }
   ch.publish(Pose{1, 0, 0, 1, -1}, core::Nanos(1));
-  while (started.load() < 3) std::this_thread::yield();  // overlap writes with reads
+  while (started.load() < 3)
+    std::this_thread::yield();  // overlap writes with reads
   for (int64_t i = 2; i <= kWrites; ++i) {
     ch.publish(Pose{static_cast<double>(i), 0, 0, i, -i}, core::Nanos(i));
   }
   done = true;
-  for (auto& t : readers) t.join();
+  for (auto& t : readers)
+    t.join();
   EXPECT_EQ(torn.load(), 0);
   EXPECT_GT(reads.load(), 0);
   EXPECT_EQ(ch.read()->count, static_cast<uint64_t>(kWrites));

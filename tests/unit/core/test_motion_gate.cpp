@@ -82,7 +82,8 @@ TEST(MotionGate, NonFiniteRequestIsRefusedAndCounted) {
   const auto out = gate.update(true, BodyVelocity{nan, 0, 0}, 0ms);
   EXPECT_TRUE(out.is_zero());
   EXPECT_EQ(gate.rejected_non_finite(), 1U);
-  const auto inf = gate.update(true, BodyVelocity{0, 0, std::numeric_limits<double>::infinity()}, 10ms);
+  const auto inf =
+      gate.update(true, BodyVelocity{0, 0, std::numeric_limits<double>::infinity()}, 10ms);
   EXPECT_TRUE(inf.is_zero());
   EXPECT_EQ(gate.rejected_non_finite(), 2U);
 }

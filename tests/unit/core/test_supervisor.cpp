@@ -67,7 +67,9 @@ class Harness {
   core::Transition last_transition_{};
 };
 
-std::string values(const core::Transition& t) { return std::string(t.values.data()); }
+std::string values(const core::Transition& t) {
+  return std::string(t.values.data());
+}
 
 }  // namespace
 

@@ -9,9 +9,9 @@ using core::TaskTiming;
 TEST(TaskStats, CountsOverrunsSkipsAndBudget) {
   TaskStats s(10ms, 3ms);
   s.record(TaskTiming{0ms, 0ms, 0ms, 1ms, 10ms, 0});      // fine
-  s.record(TaskTiming{10ms, 10ms, 10ms, 14ms, 20ms, 0});   // over budget, not an overrun
-  s.record(TaskTiming{20ms, 20ms, 20ms, 32ms, 30ms, 0});   // overrun
-  s.record(TaskTiming{30ms, 40ms, 40ms, 41ms, 50ms, 1});   // one release (30 ms) skipped
+  s.record(TaskTiming{10ms, 10ms, 10ms, 14ms, 20ms, 0});  // over budget, not an overrun
+  s.record(TaskTiming{20ms, 20ms, 20ms, 32ms, 30ms, 0});  // overrun
+  s.record(TaskTiming{30ms, 40ms, 40ms, 41ms, 50ms, 1});  // one release (30 ms) skipped
   EXPECT_EQ(s.runs(), 4U);
   EXPECT_EQ(s.budget_exceeded(), 2U);
   EXPECT_EQ(s.overruns(), 1U);

@@ -18,7 +18,8 @@ std::string read_file(const std::string& path) {
 }
 
 // Exactly one error, at `line`, about `key`, whose message contains `text`.
-void expect_error(const ConfigResult& r, int line, const std::string& key, const std::string& text) {
+void expect_error(const ConfigResult& r, int line, const std::string& key,
+                  const std::string& text) {
   ASSERT_FALSE(r.ok());
   ASSERT_EQ(r.errors.size(), 1U) << r.errors[0].to_string();
   const auto& e = r.errors[0];
@@ -152,8 +153,8 @@ TEST(Config, MissingFileIsRefused) {
 }
 
 TEST(Config, AllErrorsOfAFileAreReportedAtOnce) {
-  const auto r = load_config_text("mppi:\n  samples: -1\n  lamda: 1\ndcbf:\n  delta: x\n",
-                                  "test.yaml");
+  const auto r =
+      load_config_text("mppi:\n  samples: -1\n  lamda: 1\ndcbf:\n  delta: x\n", "test.yaml");
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.errors.size(), 3U);
 }

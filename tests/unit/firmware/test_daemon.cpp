@@ -40,7 +40,9 @@ struct SimDaemon {
   firmware::Executor executor;
 };
 
-firmware::DaemonConfig defaults() { return *firmware::load_default_config().config; }
+firmware::DaemonConfig defaults() {
+  return *firmware::load_default_config().config;
+}
 
 }  // namespace
 
@@ -114,7 +116,8 @@ std::vector<std::string> collect_notifications(F body) {
     while (!done.load()) {
       if (auto m = sock.receive(20ms)) msgs.push_back(*m);
     }
-    while (auto m = sock.receive(0ms)) msgs.push_back(*m);
+    while (auto m = sock.receive(0ms))
+      msgs.push_back(*m);
   });
   body();
   done = true;
@@ -184,7 +187,10 @@ TEST(Daemon, StopsPingingTheWatchdogWhenControlStalls) {
   }
   unsetenv("WATCHDOG_USEC");
   unsetenv("WATCHDOG_PID");
-  EXPECT_GE(count(before, "WATCHDOG=1"), 9);
+  std::string all;
+  for (const auto& m : before)
+    all += m + " / ";
+  EXPECT_GE(count(before, "WATCHDOG=1"), 9) << all;
   EXPECT_LE(count(after, "WATCHDOG=1"), 2) << "at most the pings before the stall was seen";
 }
 

@@ -93,9 +93,9 @@ TEST(Executor, TasksAreToldTheirTimeAndPeriod) {
 TEST(Executor, CountsOverrunsSkipsAndBudgetExceedances) {
   hal::SimClock clock;
   // A 100 Hz task that takes 15 ms of (virtual) time each run.
-  Executor ex(clock, kGroups,
-              {{core::TaskSpec{"slow", 100, 5000, 0, 0},
-                [&](const core::Tick& t) { clock.sleep_until(t.now + 15ms); }}});
+  Executor ex(clock, kGroups, {{core::TaskSpec{"slow", 100, 5000, 0, 0}, [&](const core::Tick& t) {
+                                  clock.sleep_until(t.now + 15ms);
+                                }}});
   run_single_until(ex, clock, 0s, 1s);
   const auto& s = ex.stats(0);
   EXPECT_GT(s.runs(), 0U);
@@ -149,11 +149,12 @@ TEST(Executor, SingleThreadModeIsDeterministic) {
     std::vector<Event> events;
     uint64_t state = 1;
     auto task = [&](std::string_view name, uint32_t rate, uint8_t prio, Nanos work) {
-      return TaskBinding{core::TaskSpec{name, rate, 1000, 0, prio}, [&, name, work](const core::Tick& t) {
-                           events.push_back({name, t.now, t.period});
-                           state = state * 6364136223846793005ULL + static_cast<uint64_t>(t.now.count());
-                           if (work > 0ns) clock.sleep_until(t.now + work);
-                         }};
+      return TaskBinding{
+          core::TaskSpec{name, rate, 1000, 0, prio}, [&, name, work](const core::Tick& t) {
+            events.push_back({name, t.now, t.period});
+            state = state * 6364136223846793005ULL + static_cast<uint64_t>(t.now.count());
+            if (work > 0ns) clock.sleep_until(t.now + work);
+          }};
     };
     Executor ex(clock, kGroups,
                 {task("tracker", 120, 90, 0ns), task("base", 50, 80, 200us),

@@ -42,7 +42,9 @@ TEST(LinuxClock, SleepsBeyondOneSliceWithoutDrift) {
 
 namespace {
 std::atomic<int> g_signals{0};
-void count_signal(int /*sig*/) { g_signals.fetch_add(1); }
+void count_signal(int /*sig*/) {
+  g_signals.fetch_add(1);
+}
 }  // namespace
 
 TEST(LinuxClock, RetriesOnEintrAndStillReachesDeadline) {
@@ -63,7 +65,8 @@ TEST(LinuxClock, RetriesOnEintrAndStillReachesDeadline) {
     woke = clock.now();
     done = true;
   });
-  while (!asleep) std::this_thread::yield();
+  while (!asleep)
+    std::this_thread::yield();
   // Interrupt the sleep with signals until the sleeper is done.
   while (!done) {
     pthread_kill(sleeper.native_handle(), SIGUSR1);

@@ -83,7 +83,8 @@ TEST(SimClock, InterruptWakesSleepersWithFalse) {
   clock.attach_thread();  // a second participant that never sleeps keeps time still
   bool result = true;
   std::thread t([&] { result = clock.sleep_until(1s); });
-  while (clock.sleepers() == 0) std::this_thread::yield();
+  while (clock.sleepers() == 0)
+    std::this_thread::yield();
   EXPECT_EQ(clock.now(), 0s);
   clock.interrupt();
   t.join();

@@ -42,7 +42,8 @@ class LatestValue {
     const uint64_t seq = seq_.load(std::memory_order_relaxed);
     seq_.store(seq + 1, std::memory_order_relaxed);
     // Release stores: a reader that sees any new word also sees the odd sequence before it.
-    for (size_t i = 0; i < kWords; ++i) words_[i].store(words[i], std::memory_order_release);
+    for (size_t i = 0; i < kWords; ++i)
+      words_[i].store(words[i], std::memory_order_release);
     seq_.store(seq + 2, std::memory_order_release);
   }
 
@@ -54,7 +55,8 @@ class LatestValue {
       if (s1 == 0) return std::nullopt;
       if (s1 & 1U) continue;  // write in progress
       // Acquire loads keep the re-check of the sequence after them.
-      for (size_t i = 0; i < kWords; ++i) words[i] = words_[i].load(std::memory_order_acquire);
+      for (size_t i = 0; i < kWords; ++i)
+        words[i] = words_[i].load(std::memory_order_acquire);
       if (seq_.load(std::memory_order_relaxed) == s1) break;
     }
     Payload p;

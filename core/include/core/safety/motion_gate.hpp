@@ -10,9 +10,9 @@
 namespace core {
 
 struct BodyVelocity {
-  double vx_mps = 0.0;   // forward
-  double vy_mps = 0.0;   // left
-  double wz_radps = 0.0; // counter-clockwise
+  double vx_mps = 0.0;    // forward
+  double vy_mps = 0.0;    // left
+  double wz_radps = 0.0;  // counter-clockwise
   [[nodiscard]] bool is_zero() const { return vx_mps == 0.0 && vy_mps == 0.0 && wz_radps == 0.0; }
 };
 

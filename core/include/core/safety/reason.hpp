@@ -94,11 +94,16 @@ constexpr std::string_view reason_text(Reason r) {
 
 constexpr std::string_view state_name(SafetyState s) {
   switch (s) {
-    case SafetyState::kInit: return "INIT";
-    case SafetyState::kArming: return "ARMING";
-    case SafetyState::kActive: return "ACTIVE";
-    case SafetyState::kHold: return "HOLD";
-    case SafetyState::kFault: return "FAULT";
+    case SafetyState::kInit:
+      return "INIT";
+    case SafetyState::kArming:
+      return "ARMING";
+    case SafetyState::kActive:
+      return "ACTIVE";
+    case SafetyState::kHold:
+      return "HOLD";
+    case SafetyState::kFault:
+      return "FAULT";
   }
   return "?";
 }

@@ -67,7 +67,7 @@ using ReasonSet = std::bitset<kReasonCount>;
 struct Transition {
   SafetyState from;
   SafetyState to;
-  Reason reason;          // primary reason in the new state (kNone when ACTIVE)
+  Reason reason;                 // primary reason in the new state (kNone when ACTIVE)
   std::array<char, 200> values;  // the values that caused it, one line, NUL-terminated
 };
 

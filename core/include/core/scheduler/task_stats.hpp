@@ -10,12 +10,12 @@
 namespace core {
 
 struct TaskTiming {
-  Nanos due;        // the earliest release that was waiting for this run
-  Nanos release;    // the release it serves (later than `due` when releases were skipped)
-  Nanos start;      // when it began
-  Nanos end;        // when it returned
-  Nanos deadline;   // the next release
-  uint64_t skipped; // releases missed before this run
+  Nanos due;         // the earliest release that was waiting for this run
+  Nanos release;     // the release it serves (later than `due` when releases were skipped)
+  Nanos start;       // when it began
+  Nanos end;         // when it returned
+  Nanos deadline;    // the next release
+  uint64_t skipped;  // releases missed before this run
 };
 
 class TaskStats {
@@ -33,7 +33,9 @@ class TaskStats {
   [[nodiscard]] uint64_t budget_exceeded() const {
     return budget_exceeded_.load(std::memory_order_relaxed);
   }
-  [[nodiscard]] Nanos last_end() const { return Nanos(last_end_ns_.load(std::memory_order_acquire)); }
+  [[nodiscard]] Nanos last_end() const {
+    return Nanos(last_end_ns_.load(std::memory_order_acquire));
+  }
   [[nodiscard]] Nanos last_start() const {
     return Nanos(last_start_ns_.load(std::memory_order_relaxed));
   }

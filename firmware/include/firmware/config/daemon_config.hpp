@@ -8,9 +8,10 @@ namespace firmware {
 
 struct DaemonConfig {
   struct Devices {
-    std::string tracker;  // hid:auto | hid:<hidraw path or serial> | serial:<port>[@baud] | sim | none
-    std::string lidar;    // udp:<bind addr>:<port> | sim | none
-    std::string base;     // socketcan:<ifname> | slcan:<tty> | virtual:<bus> | sim | none
+    std::string
+        tracker;  // hid:auto | hid:<hidraw path or serial> | serial:<port>[@baud] | sim | none
+    std::string lidar;  // udp:<bind addr>:<port> | sim | none
+    std::string base;   // socketcan:<ifname> | slcan:<tty> | virtual:<bus> | sim | none
   } devices;
 
   struct Realtime {
