@@ -33,9 +33,7 @@ int wait_signal(const sigset_t& set, std::chrono::milliseconds timeout) {
   return sig > 0 ? sig : 0;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   CLI::App app{"companiond - companion robot daemon (Amfitrack + VLP-16 + Scout Mini)"};
   std::string config_path;
   std::string check_path;
@@ -176,4 +174,17 @@ int main(int argc, char** argv) {
   spdlog::info("final timing: {}", daemon.timing_summary());
   firmware::shutdown_logging();
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    // Nothing is expected to throw past start-up; if something does, say what and fail so that
+    // systemd restarts us (the base stops by itself 500 ms after the last command).
+    (void)std::fprintf(stderr, "companiond: fatal: %s\n", e.what());
+    return 1;
+  }
 }

@@ -14,8 +14,10 @@ bool setup_logging(const std::string& level, LogSink sink) {
   if (lvl == spdlog::level::off && level != "off") return false;
 
   if (sink == LogSink::kAuto) {
+    // Read once at start-up, before any thread runs.
     const bool under_systemd =
-        std::getenv("JOURNAL_STREAM") != nullptr || std::getenv("INVOCATION_ID") != nullptr;
+        std::getenv("JOURNAL_STREAM") != nullptr ||  // NOLINT(concurrency-mt-unsafe)
+        std::getenv("INVOCATION_ID") != nullptr;     // NOLINT(concurrency-mt-unsafe)
     sink = under_systemd ? LogSink::kJournald : LogSink::kConsole;
   }
   if (spdlog::thread_pool() == nullptr) spdlog::init_thread_pool(8192, 1);

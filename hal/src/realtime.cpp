@@ -5,7 +5,7 @@
 #include <sys/mman.h>
 
 #include <cerrno>
-#include <cstring>
+#include <system_error>
 
 namespace hal {
 namespace {
@@ -13,7 +13,7 @@ namespace {
 RtResult failure(const char* what, int err) {
   RtResult r;
   r.error_number = err;
-  r.message = std::string(what) + ": " + std::strerror(err);
+  r.message = std::string(what) + ": " + std::system_category().message(err);
   if (err == EPERM) {
     r.message +=
         " (needs CAP_SYS_NICE / CAP_IPC_LOCK or an rtprio/memlock limit; "

@@ -106,46 +106,48 @@ void Supervisor::describe(const SafetyInputs& in, Nanos now, Reason r,
   const size_t n = out.size();
   switch (r) {
     case Reason::kTrackerSilent:
-      std::snprintf(buf, n, "tracker age %.1f ms > timeout %.1f ms", age_ms(in.tracker_stamp, now),
-                    to_ms(config_.tracker_timeout));
+      (void)std::snprintf(buf, n, "tracker age %.1f ms > timeout %.1f ms",
+                          age_ms(in.tracker_stamp, now), to_ms(config_.tracker_timeout));
       break;
     case Reason::kTrackerConfidenceLow:
-      std::snprintf(buf, n, "tracker confidence %s, age %.1f ms",
-                    confidence_name(in.tracker_confidence), age_ms(in.tracker_stamp, now));
+      (void)std::snprintf(buf, n, "tracker confidence %s, age %.1f ms",
+                          confidence_name(in.tracker_confidence), age_ms(in.tracker_stamp, now));
       break;
     case Reason::kPersonLost:
-      std::snprintf(buf, n, "person distance %.2f m > %.2f m", in.person_distance_m,
-                    config_.person_max_distance_m);
+      (void)std::snprintf(buf, n, "person distance %.2f m > %.2f m", in.person_distance_m,
+                          config_.person_max_distance_m);
       break;
     case Reason::kLidarSilent:
-      std::snprintf(buf, n, "lidar age %.1f ms > timeout %.1f ms", age_ms(in.lidar_stamp, now),
-                    to_ms(config_.lidar_timeout));
+      (void)std::snprintf(buf, n, "lidar age %.1f ms > timeout %.1f ms",
+                          age_ms(in.lidar_stamp, now), to_ms(config_.lidar_timeout));
       break;
     case Reason::kCostmapStale:
-      std::snprintf(buf, n, "costmap age %.1f ms > max %.1f ms", age_ms(in.costmap_stamp, now),
-                    to_ms(config_.costmap_max_age));
+      (void)std::snprintf(buf, n, "costmap age %.1f ms > max %.1f ms",
+                          age_ms(in.costmap_stamp, now), to_ms(config_.costmap_max_age));
       break;
     case Reason::kBaseFeedbackSilent:
-      std::snprintf(buf, n, "base feedback age %.1f ms > timeout %.1f ms",
-                    age_ms(in.base_feedback_stamp, now), to_ms(config_.base_feedback_timeout));
+      (void)std::snprintf(buf, n, "base feedback age %.1f ms > timeout %.1f ms",
+                          age_ms(in.base_feedback_stamp, now),
+                          to_ms(config_.base_feedback_timeout));
       break;
     case Reason::kBaseFault:
-      std::snprintf(buf, n, "base fault word 0x%04x", in.base_fault_word);
+      (void)std::snprintf(buf, n, "base fault word 0x%04x", in.base_fault_word);
       break;
     case Reason::kCanWriteErrors:
-      std::snprintf(buf, n, "CAN write errors %llu",
-                    static_cast<unsigned long long>(in.can_write_errors));
+      (void)std::snprintf(buf, n, "CAN write errors %llu",
+                          static_cast<unsigned long long>(in.can_write_errors));
       break;
     case Reason::kControlOverrun:
-      std::snprintf(buf, n, "control overruns %llu",
-                    static_cast<unsigned long long>(in.control_overruns));
+      (void)std::snprintf(buf, n, "control overruns %llu",
+                          static_cast<unsigned long long>(in.control_overruns));
       break;
     case Reason::kControlStalled:
-      std::snprintf(buf, n, "control heartbeat age %.1f ms > %.1f ms",
-                    age_ms(in.control_heartbeat, now), to_ms(config_.control_stall_timeout));
+      (void)std::snprintf(buf, n, "control heartbeat age %.1f ms > %.1f ms",
+                          age_ms(in.control_heartbeat, now), to_ms(config_.control_stall_timeout));
       break;
     default:
-      std::snprintf(buf, n, "%.*s", static_cast<int>(reason_text(r).size()), reason_text(r).data());
+      (void)std::snprintf(buf, n, "%.*s", static_cast<int>(reason_text(r).size()),
+                          reason_text(r).data());
       break;
   }
 }
@@ -223,8 +225,9 @@ SupervisorOutput Supervisor::update(const SafetyInputs& in, Nanos now) {
     if (reason_ != Reason::kNone) {
       describe(in, now, reason_, out.transition.values);
     } else {
-      std::snprintf(out.transition.values.data(), out.transition.values.size(), "%s",
-                    state_ == SafetyState::kArming ? "checking inputs" : "all inputs healthy");
+      (void)std::snprintf(
+          out.transition.values.data(), out.transition.values.size(), "%s",
+          state_ == SafetyState::kArming ? "checking inputs" : "all inputs healthy");
     }
   }
   return out;

@@ -61,7 +61,9 @@ class Loader {
         continue;
       }
       const std::string name = k.Scalar();
-      const std::string path = prefix.empty() ? name : prefix + "." + name;
+      std::string path = prefix;
+      if (!path.empty()) path += '.';
+      path += name;
       if (!keys_here.insert(name).second) {
         error(k, path, "duplicate key");
         continue;

@@ -69,9 +69,9 @@ class LatestValue {
 
  private:
   struct Payload {
-    T value;
-    int64_t stamp_ns;
-    uint64_t count;
+    T value{};
+    int64_t stamp_ns = 0;
+    uint64_t count = 0;
   };
   static constexpr size_t kWords = (sizeof(Payload) + sizeof(uint64_t) - 1) / sizeof(uint64_t);
 
