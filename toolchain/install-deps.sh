@@ -13,7 +13,7 @@ packages=(
   libpcap-dev libyaml-cpp-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-format clang-tidy
-  systemd can-utils python3
+  systemd can-utils util-linux python3
 )
 if [[ "${1:-}" == "--training" ]]; then
   packages+=(libtorch-dev libopenblas0-serial)

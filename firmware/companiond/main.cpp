@@ -129,11 +129,9 @@ int run(int argc, char** argv) {
         firmware::shutdown_logging();
         return 1;
       }
-      spdlog::warn(
-          "running WITHOUT real-time guarantees: {}{} - deadlines may be missed under "
-          "load (grant CAP_SYS_NICE and CAP_IPC_LOCK, as the systemd unit does)",
-          failed.empty() ? "" : "SCHED_FIFO refused for " + failed + ": " + why,
-          mem.ok ? "" : (failed.empty() ? "" : "; ") + mem.message);
+      spdlog::warn("running WITHOUT real-time guarantees, deadlines may be missed under load: {}{}",
+                   failed.empty() ? "" : "SCHED_FIFO refused for " + failed + ": " + why,
+                   mem.ok ? "" : (failed.empty() ? "" : "; ") + mem.message);
     } else {
       spdlog::info("real-time: memory locked, SCHED_FIFO rate-group threads");
     }

@@ -5,6 +5,8 @@
 #include <csignal>
 #include <cstdio>
 #include <fstream>
+#include <string>
+#include <vector>
 
 #include "support/child_process.hpp"
 #include "support/notify_socket.hpp"
@@ -89,4 +91,48 @@ TEST(Companiond, PrintConfigShowsEffectiveValues) {
   const std::string out = p.output();
   EXPECT_NE(out.find("samples: 777"), std::string::npos) << out;
   EXPECT_NE(out.find("horizon_steps: 100"), std::string::npos) << out;
+}
+
+// Real-time permissions withdrawn (no CAP_SYS_NICE / CAP_IPC_LOCK, rtprio and memlock limits 0):
+// with realtime.require the daemon refuses to start; without it, it warns once and runs.
+namespace {
+std::vector<std::string> without_rt(const std::vector<std::string>& args) {
+  std::vector<std::string> cmd{"/usr/bin/prlimit",
+                               "--rtprio=0",
+                               "--memlock=0",
+                               "/usr/bin/setpriv",
+                               "--bounding-set=-sys_nice,-ipc_lock",
+                               "--inh-caps=-sys_nice,-ipc_lock",
+                               COMPANIOND_PATH};
+  cmd.insert(cmd.end(), args.begin(), args.end());
+  return cmd;
+}
+bool have_rt_tools() {
+  return access("/usr/bin/prlimit", X_OK) == 0 && access("/usr/bin/setpriv", X_OK) == 0;
+}
+}  // namespace
+
+TEST(Companiond, RefusesToStartWithoutRealTimeWhenRequired) {
+  if (!have_rt_tools()) GTEST_SKIP() << "prlimit/setpriv (util-linux) not installed";
+  const std::string cfg = write_temp("require-rt.yaml", "realtime:\n  require: true\n");
+  ChildProcess p(without_rt({"--config", cfg, "--log-sink", "console"}));
+  ASSERT_TRUE(p.started());
+  const auto code = p.wait(10s);
+  ASSERT_TRUE(code.has_value());
+  EXPECT_EQ(*code, 1);
+  EXPECT_NE(p.output().find("realtime.require is set but"), std::string::npos) << p.output();
+}
+
+TEST(Companiond, WarnsOnceAndRunsWithoutRealTimeWhenNotRequired) {
+  if (!have_rt_tools()) GTEST_SKIP() << "prlimit/setpriv (util-linux) not installed";
+  ChildProcess p(without_rt({"--log-sink", "console", "--duration-s", "0.5"}));
+  ASSERT_TRUE(p.started());
+  const auto code = p.wait(10s);
+  ASSERT_TRUE(code.has_value());
+  EXPECT_EQ(*code, 0);
+  const std::string out = p.output();
+  const auto first = out.find("running WITHOUT real-time guarantees");
+  ASSERT_NE(first, std::string::npos) << out;
+  EXPECT_EQ(out.find("running WITHOUT real-time guarantees", first + 1), std::string::npos)
+      << "one warning, not one per thread";
 }
