@@ -125,6 +125,11 @@ SerialOpenResult open_termios(const std::string& path, int baud) {
 
 }  // namespace
 
+std::unique_ptr<SerialPort> adopt_serial_fd(int fd) {
+  fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) | O_NONBLOCK);
+  return std::make_unique<TermiosPort>(fd);
+}
+
 SerialOpenResult open_serial(const std::string& path, int baud) {
   sp_port* port = nullptr;
   if (sp_get_port_by_name(path.c_str(), &port) != SP_OK) {

@@ -26,5 +26,7 @@ struct SerialOpenResult {
 };
 
 SerialOpenResult open_serial(const std::string& path, int baud);
+// Wraps an already open, non-blocking terminal fd (e.g. a pty master); takes ownership.
+std::unique_ptr<SerialPort> adopt_serial_fd(int fd);
 
 }  // namespace hal
