@@ -105,19 +105,30 @@ void enables_drives_and_stops(Rig& rig) {
 
 }  // namespace
 
-TEST(ScoutDriverSim, EnablesDrivesAndStopsOnTheVirtualBus) {
-  Rig rig([](hal::Clock& c) { return virtual_pair(c, "rig1"); });
-  enables_drives_and_stops(rig);
+// Every scenario runs over the in-process virtual bus and over slcan on a pseudo-terminal.
+class ScoutDriverSim : public ::testing::TestWithParam<std::string> {
+ protected:
+  std::unique_ptr<Rig> make_rig() {
+    auto rig = std::make_unique<Rig>([&](hal::Clock& c) {
+      return GetParam() == "slcan" ? slcan_pair(c) : virtual_pair(c, "rig");
+    });
+    EXPECT_TRUE(rig->buses.first && rig->buses.second);
+    return rig;
+  }
+  bool is_virtual() const { return GetParam() == "virtual"; }
+};
+
+INSTANTIATE_TEST_SUITE_P(Transports, ScoutDriverSim, ::testing::Values("virtual", "slcan"),
+                         [](const auto& p) { return p.param; });
+
+TEST_P(ScoutDriverSim, EnablesDrivesAndStops) {
+  auto rig_ptr = make_rig();
+  enables_drives_and_stops(*rig_ptr);
 }
 
-TEST(ScoutDriverSim, EnablesDrivesAndStopsOverSlcanOnAPty) {
-  Rig rig([](hal::Clock& c) { return slcan_pair(c); });
-  ASSERT_TRUE(rig.buses.first && rig.buses.second);
-  enables_drives_and_stops(rig);
-}
-
-TEST(ScoutDriverSim, BaseStopsByItselfWhenTheDriverGoesSilent) {
-  Rig rig([](hal::Clock& c) { return virtual_pair(c, "rig2"); });
+TEST_P(ScoutDriverSim, BaseStopsByItselfWhenTheDriverGoesSilent) {
+  auto rig_ptr = make_rig();
+  Rig& rig = *rig_ptr;
   rig.run(1s, Command{0.5, 0, 0});
   ASSERT_NEAR(rig.base.velocity().vx_mps, 0.5, 1e-9);
   rig.run(490ms, Command{0, 0, 0, false});
@@ -127,8 +138,9 @@ TEST(ScoutDriverSim, BaseStopsByItselfWhenTheDriverGoesSilent) {
   EXPECT_TRUE(rig.driver.state().fault_word & scout_mini::fault::kHostCommLost);
 }
 
-TEST(ScoutDriverSim, RecoversAfterABasePowerCycle) {
-  Rig rig([](hal::Clock& c) { return virtual_pair(c, "rig3"); });
+TEST_P(ScoutDriverSim, RecoversAfterABasePowerCycle) {
+  auto rig_ptr = make_rig();
+  Rig& rig = *rig_ptr;
   rig.run(500ms, Command{0.3, 0, 0});
   ASSERT_EQ(rig.base.mode(), ControlMode::kCan);
   rig.base.power_cycle();
@@ -139,8 +151,9 @@ TEST(ScoutDriverSim, RecoversAfterABasePowerCycle) {
   EXPECT_NEAR(rig.base.velocity().vx_mps, 0.3, 1e-9);
 }
 
-TEST(ScoutDriverSim, NeverFightsTheRemoteControl) {
-  Rig rig([](hal::Clock& c) { return virtual_pair(c, "rig4"); });
+TEST_P(ScoutDriverSim, NeverFightsTheRemoteControl) {
+  auto rig_ptr = make_rig();
+  Rig& rig = *rig_ptr;
   rig.run(500ms, Command{0.3, 0, 0});
   rig.base.set_rc_takeover(true);
   rig.run(200ms, Command{0.3, 0, 0});
@@ -156,8 +169,9 @@ TEST(ScoutDriverSim, NeverFightsTheRemoteControl) {
   EXPECT_EQ(rig.base.mode(), ControlMode::kCan) << "taken back after the RC let go";
 }
 
-TEST(ScoutDriverSim, ReportsEachFault) {
-  Rig rig([](hal::Clock& c) { return virtual_pair(c, "rig5"); });
+TEST_P(ScoutDriverSim, ReportsEachFault) {
+  auto rig_ptr = make_rig();
+  Rig& rig = *rig_ptr;
   rig.run(500ms);
   rig.base.set_estop(true);
   rig.run(200ms);
@@ -188,8 +202,9 @@ TEST(ScoutDriverSim, ReportsEachFault) {
   EXPECT_GT(rig.base.velocity().vx_mps, 0.0);
 }
 
-TEST(ScoutDriverSim, DetectsFeedbackSilenceAndBusOff) {
-  Rig rig([](hal::Clock& c) { return virtual_pair(c, "rig6"); });
+TEST_P(ScoutDriverSim, DetectsFeedbackSilenceAndBusOff) {
+  auto rig_ptr = make_rig();
+  Rig& rig = *rig_ptr;
   rig.run(300ms);
   EXPECT_FALSE(rig.driver.feedback_silent(rig.clock.now()));
   rig.base.set_feedback_silent(true);
@@ -199,6 +214,7 @@ TEST(ScoutDriverSim, DetectsFeedbackSilenceAndBusOff) {
   rig.run(100ms);
   EXPECT_FALSE(rig.driver.feedback_silent(rig.clock.now()));
 
+  if (!is_virtual()) return;  // bus-off injection needs the virtual controller
   auto& host = static_cast<hal::VirtualCanBus&>(*rig.buses.first);
   host.inject_bus_off(true);
   rig.run(50ms);
@@ -210,8 +226,9 @@ TEST(ScoutDriverSim, DetectsFeedbackSilenceAndBusOff) {
   EXPECT_FALSE(rig.driver.bus_off());
 }
 
-TEST(ScoutDriverSim, ReadsTheVersion) {
-  Rig rig([](hal::Clock& c) { return virtual_pair(c, "rig7"); });
+TEST_P(ScoutDriverSim, ReadsTheVersion) {
+  auto rig_ptr = make_rig();
+  Rig& rig = *rig_ptr;
   rig.run(100ms);
   rig.driver.request_version();
   rig.run(50ms);

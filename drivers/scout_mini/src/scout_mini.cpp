@@ -98,7 +98,8 @@ void ScoutMini::poll(hal::Nanos now) {
   }
   // Keep CAN command mode: after power-on, E-stop or an RC takeover the base falls back to
   // standby and ignores 0x111 until it sees 0x421 again. Never while a person holds the RC.
-  if (!state_.in_can_mode() && !state_.rc_has_control() && !state_.protocol_v1 &&
+  if (config_.manage_mode && !state_.in_can_mode() && !state_.rc_has_control() &&
+      !state_.protocol_v1 &&
       (!mode_requested_ || now - last_mode_request_ >= config_.mode_retry_period)) {
     if (send(encode_control_mode(ControlMode::kCan)) == hal::CanSendResult::kOk) {
       ++counters_.mode_requests;

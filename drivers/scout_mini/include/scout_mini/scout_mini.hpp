@@ -19,6 +19,8 @@ struct ScoutConfig {
   bool lateral_sign_flip = false;  // +vy is left (REP-103); flip if the firmware disagrees
   hal::Nanos feedback_timeout = std::chrono::milliseconds(200);
   hal::Nanos mode_retry_period = std::chrono::milliseconds(100);  // 0x421 re-send rate limit
+  // Keep the base in CAN command mode (send 0x421 when it is not). False for listen-only tools.
+  bool manage_mode = true;
 };
 
 // Per-id reception statistics.
