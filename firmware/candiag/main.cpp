@@ -11,6 +11,7 @@
 #include <array>
 #include <atomic>
 #include <csignal>
+#include <cstdarg>
 #include <cstdio>
 #include <memory>
 #include <mutex>
@@ -29,6 +30,20 @@ using hal::Nanos;
 using namespace std::chrono_literals;
 
 std::atomic<bool> g_interrupted{false};
+
+// Console output of the tool (stdout for results, stderr for errors); printf-checked formats.
+__attribute__((format(printf, 1, 2))) void say(const char* format, ...) {
+  va_list args;
+  va_start(args, format);
+  (void)std::vprintf(format, args);
+  va_end(args);
+}
+__attribute__((format(printf, 1, 2))) void complain(const char* format, ...) {
+  va_list args;
+  va_start(args, format);
+  (void)std::vfprintf(stderr, format, args);
+  va_end(args);
+}
 void on_signal(int /*sig*/) {
   g_interrupted.store(true);
 }
@@ -225,16 +240,16 @@ bool nothing_heard(const sm::ScoutMini& d) {
 }
 
 int no_frames_error(const std::string& bus) {
-  std::fprintf(stderr,
-               "no Scout Mini frames on %s: is the base powered on, the bus wired (CAN_H/CAN_L, "
-               "120 ohm termination) and the bit rate 500 kbit/s?\n",
-               bus.c_str());
+  complain(
+      "no Scout Mini frames on %s: is the base powered on, the bus wired (CAN_H/CAN_L, "
+      "120 ohm termination) and the bit rate 500 kbit/s?\n",
+      bus.c_str());
   return kExitNoBase;
 }
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   CLI::App app{"companion-candiag - CAN diagnostics for the AgileX Scout Mini"};
   app.require_subcommand(1);
   std::string bus_uri = "socketcan:can0";
@@ -294,21 +309,21 @@ int main(int argc, char** argv) {
   jog->add_option("--duration-s", jog_s, "seconds (max 10)")->check(CLI::Range(0.0, 10.0));
   CLI11_PARSE(app, argc, argv);
 
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
+  (void)std::signal(SIGINT, on_signal);
+  (void)std::signal(SIGTERM, on_signal);
   hal::LinuxClock clock;
 
   std::unique_ptr<SimBase> simbase;
   if (with_sim) {
     if (bus_uri.rfind("virtual:", 0) != 0) {
-      std::fprintf(stderr, "--sim needs a virtual:<name> bus\n");
+      complain("--sim needs a virtual:<name> bus\n");
       return 3;
     }
     simbase = std::make_unique<SimBase>(bus_uri.substr(8), clock, sim_fault, sim_v1);
   }
   auto opened = hal::open_can(bus_uri, clock);
   if (!opened.bus) {
-    std::fprintf(stderr, "cannot open %s: %s\n", bus_uri.c_str(), opened.error.c_str());
+    complain("cannot open %s: %s\n", bus_uri.c_str(), opened.error.c_str());
     return kExitNoBase;
   }
   hal::CanBus& bus = *opened.bus;
@@ -321,8 +336,7 @@ int main(int argc, char** argv) {
     if (once) {
       listen(driver, clock, 500ms);
       if (nothing_heard(driver)) return no_frames_error(bus_uri);
-      std::printf(
-          "%s\n",
+      say("%s\n",
           (json ? json_state(driver, clock.now()) : text_state(driver, clock.now())).c_str());
       return 0;
     }
@@ -332,12 +346,12 @@ int main(int argc, char** argv) {
     while (!g_interrupted && clock.now() < end) {
       listen(driver, clock, 200ms);
       if (json) {
-        std::printf("%s\n", json_state(driver, clock.now()).c_str());
+        say("%s\n", json_state(driver, clock.now()).c_str());
       } else {
-        std::printf("\x1b[H\x1b[2J%s (Ctrl-C to quit)\n%s", bus_uri.c_str(),
-                    text_state(driver, clock.now()).c_str());
+        say("\x1b[H\x1b[2J%s (Ctrl-C to quit)\n%s", bus_uri.c_str(),
+            text_state(driver, clock.now()).c_str());
       }
-      std::fflush(stdout);
+      (void)std::fflush(stdout);
     }
     return 0;
   }
@@ -348,7 +362,7 @@ int main(int argc, char** argv) {
     if (nothing_heard(driver)) return no_frames_error(bus_uri);
     bool ok = true;
     auto line = [&](bool pass, const std::string& what) {
-      std::printf("%s %s\n", pass ? "PASS" : "FAIL", what.c_str());
+      say("%s %s\n", pass ? "PASS" : "FAIL", what.c_str());
       ok = ok && pass;
     };
     const auto& s = driver.state();
@@ -378,7 +392,7 @@ int main(int argc, char** argv) {
     line(bus.state() != hal::CanBusState::kBusOff && driver.counters().error_frames == 0,
          fmt::format("bus: {}, {} error frames", hal::to_string(bus.state()),
                      driver.counters().error_frames));
-    std::printf("%s\n", ok ? "check: PASS" : "check: FAIL");
+    say("%s\n", ok ? "check: PASS" : "check: FAIL");
     return ok ? 0 : kExitFail;
   }
 
@@ -394,16 +408,16 @@ int main(int argc, char** argv) {
           timespec rt{};
           clock_gettime(CLOCK_REALTIME, &rt);
           hal::CandumpRecord rec{rt.tv_sec, rt.tv_nsec, iface, rx->frame};
-          std::printf("%s\n", hal::format_candump_line(rec).c_str());
+          say("%s\n", hal::format_candump_line(rec).c_str());
         } else {
           const auto d = sm::decode(rx->frame);
           const std::string what = d.message ? std::string(message_name(*d.message))
                                              : "dropped: " + std::string(sm::to_string(d.error));
-          std::printf("%.6f %s %s\n", static_cast<double>(rx->stamp.count()) * 1e-9,
-                      hal::to_cansend(rx->frame).c_str(), what.c_str());
+          say("%.6f %s %s\n", static_cast<double>(rx->stamp.count()) * 1e-9,
+              hal::to_cansend(rx->frame).c_str(), what.c_str());
         }
       }
-      std::fflush(stdout);
+      (void)std::fflush(stdout);
       sleeper.sleep_until(clock.now() + 2ms);
     }
     return 0;
@@ -412,7 +426,7 @@ int main(int argc, char** argv) {
   if (app.got_subcommand(replay)) {
     hal::CandumpReader reader(replay_file);
     if (!reader.is_open()) {
-      std::fprintf(stderr, "cannot open %s\n", replay_file.c_str());
+      complain("cannot open %s\n", replay_file.c_str());
       return kExitNoBase;
     }
     hal::LinuxClock sleeper;
@@ -434,8 +448,7 @@ int main(int argc, char** argv) {
         ++failed;
       }
     }
-    std::printf(
-        "replayed %llu frames (%llu failed, %llu malformed lines) in %.3f s; log span %.3f s\n",
+    say("replayed %llu frames (%llu failed, %llu malformed lines) in %.3f s; log span %.3f s\n",
         static_cast<unsigned long long>(sent), static_cast<unsigned long long>(failed),
         static_cast<unsigned long long>(reader.malformed()),
         static_cast<double>((clock.now() - start).count()) * 1e-9,
@@ -448,22 +461,20 @@ int main(int argc, char** argv) {
     std::string err;
     if (hal::parse_candump_line("(0.000000) x " + send_frame, rec, err) !=
         hal::CandumpParse::kRecord) {
-      std::fprintf(stderr, "bad frame '%s': %s\n", send_frame.c_str(), err.c_str());
+      complain("bad frame '%s': %s\n", send_frame.c_str(), err.c_str());
       return 3;
     }
     const auto r = bus.send(rec.frame);
-    std::printf("%s: %s\n", hal::to_cansend(rec.frame).c_str(),
-                std::string(hal::to_string(r)).c_str());
+    say("%s: %s\n", hal::to_cansend(rec.frame).c_str(), std::string(hal::to_string(r)).c_str());
     return r == hal::CanSendResult::kOk ? 0 : kExitFail;
   }
 
   if (app.got_subcommand(enable)) {
     listen(driver, clock, 500ms);
     if (nothing_heard(driver)) return no_frames_error(bus_uri);
-    std::printf("control mode: %s%s\n", mode_name(driver.state().control_mode_raw).c_str(),
-                driver.state().rc_has_control()
-                    ? " (remote control has priority: release it / SWB up)"
-                    : "");
+    say("control mode: %s%s\n", mode_name(driver.state().control_mode_raw).c_str(),
+        driver.state().rc_has_control() ? " (remote control has priority: release it / SWB up)"
+                                        : "");
     return driver.state().in_can_mode() ? 0 : kExitFail;
   }
   if (app.got_subcommand(clear)) {
@@ -471,31 +482,28 @@ int main(int argc, char** argv) {
     const uint16_t before = driver.state().fault_word;
     driver.clear_faults(0);
     listen(driver, clock, 300ms);
-    std::printf("faults before 0x%04X, after 0x%04X (%s)\n", before, driver.state().fault_word,
-                fault_names(driver.state().fault_word).c_str());
+    say("faults before 0x%04X, after 0x%04X (%s)\n", before, driver.state().fault_word,
+        fault_names(driver.state().fault_word).c_str());
     return driver.state().stopping_faults() == 0 ? 0 : kExitFail;
   }
   if (app.got_subcommand(version)) {
     driver.request_version();
     listen(driver, clock, 500ms);
     if (!driver.state().version) {
-      std::fprintf(
-          stderr,
-          "no version reply (0x41A) within 0.5 s; newer firmware may answer 0x4A1 instead\n");
+      complain("no version reply (0x41A) within 0.5 s; newer firmware may answer 0x4A1 instead\n");
       return kExitFail;
     }
     const auto& v = *driver.state().version;
     auto ver = [](uint16_t x) { return fmt::format("{}.{}", x >> 8, x & 0xFF); };
-    std::printf("control hw %s, driver hw %s, control sw %s, driver sw %s\n",
-                ver(v.control_hw).c_str(), ver(v.driver_hw).c_str(), ver(v.control_sw).c_str(),
-                ver(v.driver_sw).c_str());
+    say("control hw %s, driver hw %s, control sw %s, driver sw %s\n", ver(v.control_hw).c_str(),
+        ver(v.driver_hw).c_str(), ver(v.control_sw).c_str(), ver(v.driver_sw).c_str());
     return 0;
   }
   if (app.got_subcommand(lights)) {
     const auto r = driver.set_lights(
         light_mode != 0, static_cast<uint8_t>(light_mode), static_cast<uint8_t>(brightness),
         static_cast<uint8_t>(light_mode), static_cast<uint8_t>(brightness));
-    std::printf("lights: %s\n", std::string(hal::to_string(r)).c_str());
+    say("lights: %s\n", std::string(hal::to_string(r)).c_str());
     return r == hal::CanSendResult::kOk ? 0 : kExitFail;
   }
 
@@ -513,22 +521,23 @@ int main(int argc, char** argv) {
       const Nanos now = clock.now();
       driver.poll(now);
       const auto& s = driver.state();
-      if (g_interrupted)
+      if (g_interrupted) {
         why = "interrupted";
-      else if (s.estop())
+      } else if (s.estop()) {
         why = "E-stop";
-      else if (s.stopping_faults() != 0)
+      } else if (s.stopping_faults() != 0) {
         why = "base fault " + fault_names(s.fault_word);
-      else if (s.rc_has_control())
+      } else if (s.rc_has_control()) {
         why = "remote control took over";
-      else if (driver.bus_off())
+      } else if (driver.bus_off()) {
         why = "CAN bus-off";
-      else if (now - start > 300ms && driver.feedback_silent(now))
+      } else if (now - start > 300ms && driver.feedback_silent(now)) {
         why = "base feedback silent";
-      else if (now >= end)
+      } else if (now >= end) {
         why = "duration reached";
-      else
+      } else {
         why.clear();
+      }
       if (!why.empty()) break;
       if (now - start >= 300ms || s.in_can_mode()) driver.command(vx, vy, wz, now);
       next += 20ms;
@@ -540,10 +549,18 @@ int main(int argc, char** argv) {
     }
     listen(driver, clock, 100ms);
     const auto& s = driver.state();
-    std::printf(
-        "jog stopped: %s; odometry x %+.3f m y %+.3f m theta %+.3f rad; velocity now %.3f m/s\n",
+    say("jog stopped: %s; odometry x %+.3f m y %+.3f m theta %+.3f rad; velocity now %.3f m/s\n",
         why.c_str(), s.odom.x_m, s.odom.y_m, s.odom.theta_rad, s.velocity.vx_mps);
     return why == "duration reached" ? 0 : kExitFail;
   }
   return 3;
+}
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    complain("companion-candiag: %s\n", e.what());
+    return 3;
+  }
 }

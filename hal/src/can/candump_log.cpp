@@ -125,11 +125,11 @@ CandumpParse parse_candump_line(std::string_view line, CandumpRecord& out, std::
 std::string format_candump_line(const CandumpRecord& rec, bool nine_digits) {
   char stamp[48];
   if (nine_digits) {
-    std::snprintf(stamp, sizeof(stamp), "(%lld.%09lld) ", static_cast<long long>(rec.sec),
-                  static_cast<long long>(rec.nsec));
+    (void)std::snprintf(stamp, sizeof(stamp), "(%lld.%09lld) ", static_cast<long long>(rec.sec),
+                        static_cast<long long>(rec.nsec));
   } else {
-    std::snprintf(stamp, sizeof(stamp), "(%lld.%06lld) ", static_cast<long long>(rec.sec),
-                  static_cast<long long>(rec.nsec / 1000));
+    (void)std::snprintf(stamp, sizeof(stamp), "(%lld.%06lld) ", static_cast<long long>(rec.sec),
+                        static_cast<long long>(rec.nsec / 1000));
   }
   return std::string(stamp) + rec.iface + " " + to_cansend(rec.frame);
 }

@@ -43,6 +43,7 @@ CanFrame from_linux(const can_frame& in) {
 
 std::vector<can_filter> make_filters(const std::vector<uint32_t>& standard_ids) {
   std::vector<can_filter> out;
+  out.reserve(standard_ids.size());
   for (const uint32_t id : standard_ids) {
     // Match the id exactly, standard frames only (EFF flag must be clear), data or remote.
     out.push_back(can_filter{id & CAN_SFF_MASK, CAN_SFF_MASK | CAN_EFF_FLAG});

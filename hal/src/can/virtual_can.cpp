@@ -15,8 +15,8 @@ namespace {
 
 std::mutex g_registry_mutex;
 std::map<std::string, std::weak_ptr<VirtualCanBus::Network>>& registry() {
-  static std::map<std::string, std::weak_ptr<VirtualCanBus::Network>> kRegistry;
-  return kRegistry;
+  static std::map<std::string, std::weak_ptr<VirtualCanBus::Network>> networks;
+  return networks;
 }
 
 }  // namespace
