@@ -12,6 +12,7 @@
 #include "firmware/daemon.hpp"
 #include "firmware/logging.hpp"
 #include "firmware/task_table.hpp"
+#include "hal/can/can_bus.hpp"
 #include "hal/linux_clock.hpp"
 #include "hal/realtime.hpp"
 #include "hal/sd_notify.hpp"
@@ -106,6 +107,23 @@ int run(int argc, char** argv) {
   hal::SystemdNotifier notifier;
   hal::LinuxClock clock;
   firmware::Daemon daemon(cfg, notifier);
+  // The base's CAN link. Without it the robot cannot move and the supervisor says why
+  // (base feedback silent); the daemon still runs so that it can be diagnosed.
+  const std::string& base_uri = cfg.devices.base;
+  if (base_uri != "none" && base_uri != "sim") {
+    auto opened = hal::open_can(base_uri, clock);
+    if (!opened.bus) {
+      spdlog::error("base: cannot open {}: {}", base_uri, opened.error);
+    } else if (!daemon.attach_base(std::move(opened.bus))) {
+      spdlog::critical("task table: base and control tasks must share a rate group");
+      firmware::shutdown_logging();
+      return 1;
+    } else {
+      spdlog::info("base: Scout Mini on {}", base_uri);
+    }
+  } else if (base_uri == "sim") {
+    spdlog::warn("base: 'sim' needs the simulated world (issue 7); no base attached");
+  }
   firmware::Executor executor(clock, firmware::group_table(), daemon.bindings());
   daemon.attach(executor);
   executor.start(clock.now() + std::chrono::milliseconds(10), cfg.realtime.enable);

@@ -14,6 +14,7 @@ using core::Nanos;
 namespace {
 // A safety snapshot older than this means the supervisor task is not running.
 constexpr Nanos kSnapshotMaxAge = std::chrono::milliseconds(100);
+constexpr int64_t kNotYet = std::numeric_limits<int64_t>::max();
 }  // namespace
 
 core::SupervisorConfig supervisor_config(const DaemonConfig& cfg) {
@@ -57,14 +58,55 @@ bool Daemon::shutdown_complete() const {
   if (!shutdown_.load(std::memory_order_acquire)) return false;
   const auto s = safety_.read();
   const auto c = command_.read();
-  return s && s->value.reason == core::Reason::kShutdown && c && c->value.is_zero() &&
-         c->stamp >= s->stamp;
+  const bool commanded_zero = s && s->value.reason == core::Reason::kShutdown && c &&
+                              c->value.is_zero() && c->stamp >= s->stamp;
+  if (!commanded_zero || !base_) return commanded_zero;
+  // With a base: its own feedback must confirm standstill, measured after the zero command.
+  const auto b = base_health_.read();
+  const Nanos since(shutdown_seen_at_ns_.load(std::memory_order_acquire));
+  return b && b->value.feedback_stamp != core::kNever && b->value.feedback_stamp > since &&
+         b->value.vx_mps == 0.0 && b->value.vy_mps == 0.0 && b->value.wz_radps == 0.0;
 }
 
 // ---- input tasks: empty until their drivers land (the table's `pending` says so) ------------
 
 void Daemon::tracker_task(const core::Tick& /*tick*/) {}
-void Daemon::base_task(const core::Tick& /*tick*/) {}
+bool Daemon::attach_base(std::unique_ptr<hal::CanBus> bus) {
+  uint8_t base_group = 0;
+  uint8_t control_group = 1;
+  for (const TaskRow& row : task_table()) {
+    if (row.spec.name == "base") base_group = row.spec.group;
+    if (row.spec.name == "control") control_group = row.spec.group;
+  }
+  if (base_group != control_group) return false;
+  scout_mini::ScoutConfig sc;
+  sc.limits = {cfg_.limits.vx_max_mps, cfg_.limits.vy_max_mps, cfg_.limits.wz_max_radps};
+  sc.feedback_timeout = core::from_ms(cfg_.supervisor.base_feedback_timeout_ms);
+  base_bus_ = std::move(bus);
+  base_ = std::make_unique<scout_mini::ScoutMini>(*base_bus_, sc);
+  return true;
+}
+
+// ---- base: Scout Mini feedback, CAN mode, health for the supervisor ---------------------------
+
+void Daemon::base_task(const core::Tick& tick) {
+  if (!base_) return;
+  base_->poll(tick.now);
+  const auto& st = base_->state();
+  BaseHealth h;
+  h.feedback_stamp = base_->last_feedback() == Nanos(0) ? core::kNever : base_->last_feedback();
+  h.stopping_faults = st.stopping_faults();
+  h.fault_word = st.fault_word;
+  h.estop = st.estop();
+  h.rc_override = st.rc_has_control();
+  h.bus_off = base_->bus_off();
+  h.can_mode = st.in_can_mode();
+  h.write_errors = base_->counters().write_errors;
+  h.vx_mps = st.velocity.vx_mps;
+  h.vy_mps = st.velocity.vy_mps;
+  h.wz_radps = st.velocity.wz_radps;
+  base_health_.publish(h, tick.now);
+}
 void Daemon::lidar_task(const core::Tick& /*tick*/) {}
 void Daemon::policy_task(const core::Tick& /*tick*/) {}
 
@@ -76,7 +118,11 @@ void Daemon::control_task(const core::Tick& tick) {
   // No controller yet (issue 6): request standstill. The gate still runs so the stop ramp and
   // the command stream are real.
   const core::BodyVelocity requested{};
-  command_.publish(gate_.update(allowed, requested, tick.now), tick.now);
+  const core::BodyVelocity cmd = gate_.update(allowed, requested, tick.now);
+  command_.publish(cmd, tick.now);
+  // Every path to the wheels passes the gate above; a zero command is still streamed (the base
+  // stops by itself 500 ms after the last one).
+  if (base_) base_->command(cmd.vx_mps, cmd.vy_mps, cmd.wz_radps, tick.now);
 }
 
 // ---- supervisor ------------------------------------------------------------------------------
@@ -86,6 +132,9 @@ void Daemon::supervisor_task(const core::Tick& tick) {
   in.initialized = initialized_.load(std::memory_order_acquire);
   in.shutdown = shutdown_.load(std::memory_order_acquire);
   if (in.initialized && initialized_at_ == core::kNever) initialized_at_ = tick.now;
+  if (in.shutdown && shutdown_seen_at_ns_.load(std::memory_order_relaxed) == kNotYet) {
+    shutdown_seen_at_ns_.store(tick.now.count(), std::memory_order_release);
+  }
 
   if (executor_ != nullptr) {
     const size_t control = executor_->find("control");
@@ -95,6 +144,16 @@ void Daemon::supervisor_task(const core::Tick& tick) {
       in.control_heartbeat = st.runs() > 0 ? st.last_end() : initialized_at_;
       in.control_overruns = st.overruns();
     }
+  }
+
+  if (const auto base = base_health_.read()) {
+    const BaseHealth& h = base->value;
+    in.base_feedback_stamp = h.feedback_stamp;
+    in.base_fault_word = h.stopping_faults;
+    in.base_estop = h.estop;
+    in.rc_override = h.rc_override;
+    in.can_bus_off = h.bus_off;
+    in.can_write_errors = h.write_errors;
   }
 
   const core::SupervisorOutput out = supervisor_.update(in, tick.now);

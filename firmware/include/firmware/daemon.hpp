@@ -3,6 +3,8 @@
 // through core::Tick and exchange data only through latest-value channels.
 #include <atomic>
 #include <cstdint>
+#include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -12,7 +14,9 @@
 #include "firmware/config/daemon_config.hpp"
 #include "firmware/logging.hpp"
 #include "firmware/scheduler/executor.hpp"
+#include "hal/can/can_bus.hpp"
 #include "hal/sd_notify.hpp"
+#include "scout_mini/scout_mini.hpp"
 
 namespace firmware {
 
@@ -26,6 +30,19 @@ struct SafetySnapshot {
 };
 static_assert(core::kReasonCount <= 32, "active_mask holds one bit per reason");
 
+// What the base task publishes about the Scout Mini for the supervisor and the status.
+struct BaseHealth {
+  core::Nanos feedback_stamp = core::kNever;  // latest 0x211/0x221
+  uint16_t stopping_faults = 0;
+  uint16_t fault_word = 0;
+  bool estop = false;
+  bool rc_override = false;
+  bool bus_off = false;
+  bool can_mode = false;
+  uint64_t write_errors = 0;
+  double vx_mps = 0, vy_mps = 0, wz_radps = 0;  // measured
+};
+
 core::SupervisorConfig supervisor_config(const DaemonConfig& cfg);
 core::StopLimits stop_limits(const DaemonConfig& cfg);
 
@@ -35,6 +52,11 @@ class Daemon {
 
   // The task table bound to this daemon, for an Executor.
   std::vector<TaskBinding> bindings();
+  // The Scout Mini's CAN link (optional: without it the supervisor holds, base feedback silent).
+  // Must be called before the executor starts. The base and control tasks share the driver, so
+  // they must be in one rate group: returns false (refuse to start) otherwise.
+  bool attach_base(std::unique_ptr<hal::CanBus> bus);
+  [[nodiscard]] const core::LatestValue<BaseHealth>& base_health() const { return base_health_; }
   // The executor running the bindings (the supervisor and the report read its statistics).
   void attach(const Executor& executor) { executor_ = &executor; }
 
@@ -73,6 +95,8 @@ class Daemon {
 
   std::atomic<bool> initialized_{false};
   std::atomic<bool> shutdown_{false};
+  // When the supervisor first saw the shutdown request (monotonic ns; max until then).
+  std::atomic<int64_t> shutdown_seen_at_ns_{std::numeric_limits<int64_t>::max()};
 
   // supervisor task state
   core::Supervisor supervisor_;
@@ -80,6 +104,11 @@ class Daemon {
   core::Nanos last_watchdog_ping_ = core::kNever;
   std::optional<std::chrono::microseconds> watchdog_interval_;
   core::LatestValue<SafetySnapshot> safety_;
+
+  // base (driver owned by the realtime group's thread: base and control tasks)
+  std::unique_ptr<hal::CanBus> base_bus_;
+  std::unique_ptr<scout_mini::ScoutMini> base_;
+  core::LatestValue<BaseHealth> base_health_;
 
   // control task state
   core::MotionGate gate_;

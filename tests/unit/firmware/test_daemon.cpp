@@ -4,12 +4,15 @@
 
 #include <algorithm>
 #include <atomic>
+#include <functional>
 #include <thread>
 
 #include "firmware/config/config_loader.hpp"
 #include "firmware/daemon.hpp"
 #include "firmware/task_table.hpp"
+#include "hal/can/virtual_can.hpp"
 #include "hal/sim_clock.hpp"
+#include "sim/sim_scout_mini.hpp"
 #include "support/notify_socket.hpp"
 
 using namespace std::chrono_literals;
@@ -95,8 +98,7 @@ TEST(Daemon, WithNoDevicesItHoldsBecauseTheTrackerIsSilentAndSaysSo) {
   const std::string status = d.daemon.status_line();
   EXPECT_EQ(status.rfind("HOLD: tracker silent", 0), 0U) << status;
   EXPECT_NE(status.find("control 100Hz"), std::string::npos) << status;
-  EXPECT_NE(status.find("not yet implemented: tracker, base, control, policy, lidar"),
-            std::string::npos)
+  EXPECT_NE(status.find("not yet implemented: tracker, control, policy, lidar"), std::string::npos)
       << status;
   const auto sent = sock.receive_containing("STATUS=HOLD: tracker silent", 1s);
   EXPECT_TRUE(sent.has_value());
@@ -223,4 +225,93 @@ TEST(Daemon, SameInputsSameOutputsBitForBit) {
                            c->stamp, d.daemon.status_line());
   };
   EXPECT_EQ(run(), run());
+}
+
+// The daemon with the simulated Scout Mini on a virtual CAN bus: the base task enables CAN mode
+// and reports the base's health to the supervisor; the control task streams the gated command.
+namespace {
+struct DaemonWithBase {
+  // `script` runs in the world task at every 5 ms step, before the daemon's tasks.
+  explicit DaemonWithBase(std::function<void(Nanos, DaemonWithBase&)> script = {})
+      : daemon(defaults(), notifier), base_bus("daemon-base", clock), base(base_bus) {
+    EXPECT_TRUE(daemon.attach_base(std::make_unique<hal::VirtualCanBus>("daemon-base", clock)));
+    auto tasks = daemon.bindings();
+    tasks.push_back(
+        {core::TaskSpec{"world", 200, 100, 0, 255}, [this, script](const core::Tick& t) {
+           if (script) script(t.now, *this);
+           base.step(t.now);
+         }});
+    executor = std::make_unique<firmware::Executor>(clock, firmware::group_table(), tasks);
+    daemon.attach(*executor);
+    daemon.mark_initialized();
+  }
+  void run_until(Nanos end) {
+    clock.set_horizon(end);
+    std::thread stopper([&] {
+      clock.wait_until_idle_at(end);
+      executor->stop();
+    });
+    executor->run(0s);
+    stopper.join();
+  }
+  hal::SimClock clock;
+  hal::SystemdNotifier notifier;
+  firmware::Daemon daemon;
+  hal::VirtualCanBus base_bus;
+  sim::SimScoutMini base;
+  std::unique_ptr<firmware::Executor> executor;
+};
+
+bool active(const firmware::SafetySnapshot& s, core::Reason r) {
+  return (s.active_mask >> core::reason_index(r) & 1U) != 0;
+}
+}  // namespace
+
+TEST(DaemonWithBase, EnablesTheBaseStreamsZeroWhileHoldingAndSeesItsFeedback) {
+  DaemonWithBase d;
+  d.run_until(2s);
+  EXPECT_EQ(d.base.mode(), scout_mini::ControlMode::kCan) << "the base task enabled CAN mode";
+  EXPECT_GE(d.base.commands_accepted(), 150U) << "0x111 streamed at the control rate";
+  EXPECT_EQ(d.base.velocity().vx_mps, 0.0) << "holding (tracker silent): zero commanded";
+  const auto s = d.daemon.safety().read()->value;
+  EXPECT_EQ(s.state, core::SafetyState::kHold);
+  EXPECT_EQ(s.reason, core::Reason::kTrackerSilent);
+  EXPECT_FALSE(active(s, core::Reason::kBaseFeedbackSilent)) << "the base's feedback arrives";
+  const auto h = d.daemon.base_health().read();
+  ASSERT_TRUE(h);
+  EXPECT_TRUE(h->value.can_mode);
+}
+
+TEST(DaemonWithBase, BaseSilenceAndEstopReachTheSupervisor) {
+  bool silent_seen = false;
+  DaemonWithBase d([&](Nanos now, DaemonWithBase& w) {
+    if (now == 1s) w.base.set_feedback_silent(true);
+    if (now == 1500ms) {
+      silent_seen = active(w.daemon.safety().read()->value, core::Reason::kBaseFeedbackSilent);
+      w.base.set_feedback_silent(false);
+      w.base.set_estop(true);
+    }
+  });
+  d.run_until(2s);
+  EXPECT_TRUE(silent_seen);
+  const auto s = d.daemon.safety().read()->value;
+  EXPECT_EQ(s.state, core::SafetyState::kFault);
+  EXPECT_EQ(s.reason, core::Reason::kBaseEstop);
+}
+
+TEST(DaemonWithBase, ShutdownCompletesOnlyOnceTheBaseReportsStandstill) {
+  bool complete_before_feedback = true;
+  DaemonWithBase d([&](Nanos now, DaemonWithBase& w) {
+    if (now == 1s) {
+      w.base.set_feedback_silent(true);  // no confirmation possible
+      w.daemon.request_shutdown();
+    }
+    if (now == 1400ms) {
+      complete_before_feedback = w.daemon.shutdown_complete();
+      w.base.set_feedback_silent(false);
+    }
+  });
+  d.run_until(1600ms);
+  EXPECT_FALSE(complete_before_feedback) << "zero commanded is not enough without the base's word";
+  EXPECT_TRUE(d.daemon.shutdown_complete());
 }
