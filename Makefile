@@ -1,10 +1,12 @@
 # Thin wrappers over CMake presets. The two commands of the README:
 #   make run    install dependencies, build, run companiond (built-in defaults / simulated world)
 #   make test   install dependencies, build, run every test (ThreadSanitizer pass included)
-.PHONY: run test deps build bench format tidy clean
+.PHONY: run test deps build bench fuzz format tidy clean
 
 JOBS ?= $(shell nproc)
 TSAN_TARGETS := test_core_channel test_hal_clock test_firmware_executor test_firmware_daemon
+FUZZERS := fuzz_candump_line fuzz_slcan_stream fuzz_scout_decode
+FUZZ_SECONDS ?= 10
 
 deps:
 	@bash toolchain/install-deps.sh
@@ -23,12 +25,27 @@ test: build
 	@cmake --build --preset tsan -j $(JOBS) --target $(TSAN_TARGETS)
 	@echo "== ThreadSanitizer: concurrency tests =="
 	@ctest --test-dir build/tsan -L concurrency --output-on-failure -j $(JOBS)
+	@$(MAKE) --no-print-directory fuzz FUZZ_SECONDS=$(FUZZ_SECONDS)
 	@echo "== all tests =="
 	@ctest --preset dev -j $(JOBS)
 
 bench: deps
 	@cmake --preset release -DCOMPANION_BUILD_BENCH=ON > /dev/null
 	@cmake --build --preset release -j $(JOBS) --target bench_core bench_scheduler
+
+# Coverage-guided fuzzing of the decoders (clang + libFuzzer), FUZZ_SECONDS each, starting from
+# the seed corpora in tests/fuzz/corpus (copied: the repository is not modified).
+fuzz: deps
+	@cmake --preset fuzz > /dev/null
+	@cmake --build --preset fuzz -j $(JOBS) --target $(FUZZERS)
+	@set -e; work=$$(mktemp -d); for f in $(FUZZERS); do \
+	  mkdir -p $$work/$$f && cp tests/fuzz/corpus/$$f/* $$work/$$f/; \
+	  echo "== fuzz $$f ($(FUZZ_SECONDS) s) =="; \
+	  build/fuzz/tests/fuzz/$$f -max_total_time=$(FUZZ_SECONDS) -print_final_stats=0 \
+	    -artifact_prefix=$$work/ $$work/$$f 2>&1 | grep -E "DONE|ERROR|SUMMARY" || true; \
+	  if ls $$work/crash-* $$work/leak-* $$work/timeout-* > /dev/null 2>&1; then \
+	    echo "fuzz $$f: failing input kept in $$work"; exit 1; fi; \
+	done; rm -rf $$work
 
 format:
 	@git ls-files '*.cpp' '*.hpp' | xargs clang-format -i

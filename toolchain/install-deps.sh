@@ -12,12 +12,15 @@ packages=(
   libeigen3-dev libspdlog-dev libfmt-dev libserialport-dev libhidapi-dev libsystemd-dev
   libpcap-dev libyaml-cpp-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  clang-format clang-tidy
+  clang clang-format clang-tidy
   systemd can-utils util-linux python3
 )
 if [[ "${1:-}" == "--training" ]]; then
   packages+=(libtorch-dev libopenblas0-serial)
 fi
+
+# libFuzzer's runtime: its own package on Debian 12 (on Ubuntu 22.04 it comes with clang).
+if apt-cache show libclang-rt-14-dev > /dev/null 2>&1; then packages+=(libclang-rt-14-dev); fi
 
 missing=()
 for p in "${packages[@]}"; do

@@ -321,7 +321,11 @@ int run(int argc, char** argv) {
     }
     simbase = std::make_unique<SimBase>(bus_uri.substr(8), clock, sim_fault, sim_v1);
   }
-  auto opened = hal::open_can(bus_uri, clock);
+  // dump/send/replay see the whole bus; the Scout commands only need its feedback ids.
+  const bool whole_bus =
+      app.got_subcommand(dump) || app.got_subcommand(send) || app.got_subcommand(replay);
+  auto opened = hal::open_can(bus_uri, clock,
+                              whole_bus ? std::vector<uint32_t>{} : scout_mini::feedback_ids());
   if (!opened.bus) {
     complain("cannot open %s: %s\n", bus_uri.c_str(), opened.error.c_str());
     return kExitNoBase;

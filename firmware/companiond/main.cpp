@@ -111,7 +111,7 @@ int run(int argc, char** argv) {
   // (base feedback silent); the daemon still runs so that it can be diagnosed.
   const std::string& base_uri = cfg.devices.base;
   if (base_uri != "none" && base_uri != "sim") {
-    auto opened = hal::open_can(base_uri, clock);
+    auto opened = hal::open_can(base_uri, clock, scout_mini::feedback_ids());
     if (!opened.bus) {
       spdlog::error("base: cannot open {}: {}", base_uri, opened.error);
     } else if (!daemon.attach_base(std::move(opened.bus))) {

@@ -51,6 +51,27 @@ int32_t quantise(double value, double limit, double unit, bool& clamped, bool& n
 
 }  // namespace
 
+const std::vector<uint32_t>& feedback_ids() {
+  static const std::vector<uint32_t> kIds{id::kSystemState,
+                                          id::kMotionState,
+                                          id::kLightState,
+                                          id::kRcState,
+                                          0x251,
+                                          0x252,
+                                          0x253,
+                                          0x254,
+                                          0x261,
+                                          0x262,
+                                          0x263,
+                                          0x264,
+                                          id::kOdometry,
+                                          id::kVersionReply,
+                                          id::kBmsBasic,
+                                          id::kBmsStatus,
+                                          id::kV1SystemState};
+  return kIds;
+}
+
 std::string_view fault_bit_name(uint16_t bit) {
   switch (bit) {
     case fault::kBatteryUnderVoltageFault:
@@ -100,7 +121,9 @@ std::string_view to_string(DecodeError e) {
 // is assigned here (a known false positive of GCC's variant/optional analysis); every member of
 // every message is initialised below.
 #pragma GCC diagnostic push
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 Decoded decode(const CanFrame& f) {
   Decoded d;
   auto fail = [&](DecodeError e) {

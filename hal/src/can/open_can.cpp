@@ -7,7 +7,8 @@
 
 namespace hal {
 
-CanOpenResult open_can(std::string_view uri, Clock& clock) {
+CanOpenResult open_can(std::string_view uri, Clock& clock,
+                       const std::vector<uint32_t>& receive_ids) {
   const auto colon = uri.find(':');
   if (colon == std::string_view::npos || colon + 1 >= uri.size()) {
     return {nullptr, "CAN URI '" + std::string(uri) +
@@ -16,7 +17,7 @@ CanOpenResult open_can(std::string_view uri, Clock& clock) {
   const std::string scheme(uri.substr(0, colon));
   std::string target(uri.substr(colon + 1));
   if (scheme == "virtual") return {std::make_unique<VirtualCanBus>(target, clock), ""};
-  if (scheme == "socketcan") return SocketCanBus::open(target, {}, clock);
+  if (scheme == "socketcan") return SocketCanBus::open(target, receive_ids, clock);
   if (scheme == "slcan") {
     int baud = 115200;  // ignored by USB-CDC adapters, used by UART ones
     if (const auto at = target.find('@'); at != std::string::npos) {

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -213,4 +214,18 @@ TEST(Odometry, GapsAreNotIntegrated) {
   odo.add(1.0, 0, 0, std::chrono::milliseconds(20));
   odo.add(1.0, 0, 0, std::chrono::milliseconds(2000));  // 1.98 s of silence
   EXPECT_NEAR(odo.pose().x_m, 0.02, 1e-12);
+}
+
+TEST(ScoutCodec, FeedbackIdsCoverEveryDecodedIdAndV1) {
+  const auto& ids = sm::feedback_ids();
+  for (uint32_t id = 0; id < 0x800; ++id) {
+    CanFrame f;
+    f.id = id;
+    f.dlc = 8;
+    const auto d = sm::decode(f);
+    const bool wanted = d.message.has_value() || d.error == sm::DecodeError::kProtocolV1;
+    const bool listed = std::find(ids.begin(), ids.end(), id) != ids.end();
+    if (id == sm::id::kV1MotionCommand) continue;  // host -> base in V1: never received
+    EXPECT_EQ(wanted, listed) << std::hex << id;
+  }
 }

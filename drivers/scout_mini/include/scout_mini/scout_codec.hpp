@@ -6,6 +6,7 @@
 #include <optional>
 #include <string_view>
 #include <variant>
+#include <vector>
 
 #include "hal/can/can_frame.hpp"
 
@@ -30,6 +31,10 @@ inline constexpr uint32_t kBmsStatus = 0x362;
 inline constexpr uint32_t kV1SystemState = 0x151;  // protocol V1 (unsupported)
 inline constexpr uint32_t kV1MotionCommand = 0x130;
 }  // namespace id
+
+// Every id the base sends (V2), plus the V1 status id so that V1 firmware is recognised: the
+// receive filter of a SocketCAN link to the base.
+const std::vector<uint32_t>& feedback_ids();
 
 enum class ControlMode : uint8_t { kStandby = 0, kCan = 1, kSerial = 2, kRemote = 3 };
 enum class VehicleState : uint8_t { kNormal = 0, kEstop = 1, kException = 2 };

@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "hal/can/can_frame.hpp"
 
@@ -51,7 +52,9 @@ struct CanOpenResult {
 };
 
 // Opens "socketcan:<ifname>", "slcan:<serial device>[@baud]" or "virtual:<name>".
-// Frames are stamped with `clock` (monotonic) on reception.
-CanOpenResult open_can(std::string_view uri, Clock& clock);
+// Frames are stamped with `clock` (monotonic) on reception. `receive_ids`: standard ids the
+// caller needs; SocketCAN installs them as kernel filters (others: everything is received).
+CanOpenResult open_can(std::string_view uri, Clock& clock,
+                       const std::vector<uint32_t>& receive_ids = {});
 
 }  // namespace hal
