@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "hal/can/can_bus.hpp"
+#include "hal/can/hex.hpp"
 
 namespace hal {
 
@@ -17,11 +18,7 @@ std::string to_cansend(const CanFrame& f) {
     if (f.dlc > 0) s += static_cast<char>('0' + f.dlc);
     return s;
   }
-  static constexpr char kHex[] = "0123456789ABCDEF";
-  for (uint8_t i = 0; i < f.dlc && i < 8; ++i) {
-    s += kHex[f.data[i] >> 4];
-    s += kHex[f.data[i] & 0xF];
-  }
+  hex::append_bytes(s, f.data.data(), f.dlc > 8 ? 8 : f.dlc);
   return s;
 }
 

@@ -3,21 +3,16 @@
 #include <cctype>
 #include <cstdio>
 
+#include "hal/can/hex.hpp"
+
 namespace hal {
 namespace {
-
-int hex_value(char c) {
-  if (c >= '0' && c <= '9') return c - '0';
-  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-  return -1;
-}
 
 bool parse_hex(std::string_view s, uint64_t& out) {
   if (s.empty() || s.size() > 16) return false;
   out = 0;
   for (const char c : s) {
-    const int v = hex_value(c);
+    const int v = hex::digit_value(c);
     if (v < 0) return false;
     out = out * 16 + static_cast<uint64_t>(v);
   }
@@ -112,8 +107,8 @@ CandumpParse parse_candump_line(std::string_view line, CandumpRecord& out, std::
     if (compact.size() > 16) return fail(error, "more than 8 data bytes");
     cf.dlc = static_cast<uint8_t>(compact.size() / 2);
     for (size_t i = 0; i < cf.dlc; ++i) {
-      const int hi = hex_value(compact[2 * i]);
-      const int lo = hex_value(compact[2 * i + 1]);
+      const int hi = hex::digit_value(compact[2 * i]);
+      const int lo = hex::digit_value(compact[2 * i + 1]);
       if (hi < 0 || lo < 0) return fail(error, "bad data hex digit");
       cf.data[i] = static_cast<uint8_t>(hi * 16 + lo);
     }

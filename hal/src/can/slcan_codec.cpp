@@ -3,23 +3,18 @@
 #include <array>
 #include <cstdio>
 
+#include "hal/can/hex.hpp"
+
 namespace hal::slcan {
 namespace {
 
 constexpr size_t kMaxLine = 1 + 8 + 1 + 16 + 4;  // 'T' + id + dlc + data + optional timestamp
 constexpr size_t kMaxFramesQueued = 1024;
 
-int hex_value(char c) {
-  if (c >= '0' && c <= '9') return c - '0';
-  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-  return -1;
-}
-
 std::optional<uint32_t> parse_hex(std::string_view s) {
   uint32_t v = 0;
   for (const char c : s) {
-    const int h = hex_value(c);
+    const int h = hex::digit_value(c);
     if (h < 0) return std::nullopt;
     v = v * 16 + static_cast<uint32_t>(h);
   }
@@ -33,7 +28,7 @@ std::optional<CanFrame> parse_frame(std::string_view l) {
   const size_t id_len = extended ? 8 : 3;
   if (l.size() < 1 + id_len + 1) return std::nullopt;
   const auto id = parse_hex(l.substr(1, id_len));
-  const int dlc = hex_value(l[1 + id_len]);
+  const int dlc = hex::digit_value(l[1 + id_len]);
   if (!id || dlc < 0 || dlc > 8) return std::nullopt;
   if (extended ? *id > 0x1FFFFFFF : *id > 0x7FF) return std::nullopt;
   const size_t data_len = remote ? 0 : static_cast<size_t>(dlc) * 2;
@@ -76,13 +71,7 @@ std::optional<std::string> encode(const CanFrame& f) {
     n = std::snprintf(buf, sizeof(buf), "%c%03X%u", kind, f.id, f.dlc);
   }
   std::string s(buf, static_cast<size_t>(n));
-  if (!f.remote) {
-    static constexpr char kHex[] = "0123456789ABCDEF";
-    for (uint8_t i = 0; i < f.dlc; ++i) {
-      s += kHex[f.data[i] >> 4];
-      s += kHex[f.data[i] & 0xF];
-    }
-  }
+  if (!f.remote) hex::append_bytes(s, f.data.data(), f.dlc);
   s += '\r';
   return s;
 }
