@@ -38,7 +38,8 @@ TEST(Candiag, MonitorOnceJsonDescribesTheBase) {
       << "monitor only listens: it does not enable CAN mode";
   EXPECT_NE(r.out.find("\"battery_v\":25.2"), std::string::npos) << r.out;
   EXPECT_TRUE(std::regex_search(
-      r.out, std::regex("\"0x221\":\\{\"count\":[1-9][0-9]*,\"rate_hz\":(3[5-9]|[45][0-9]|6[0-5])")))
+      r.out,
+      std::regex("\"0x221\":\\{\"count\":[1-9][0-9]*,\"rate_hz\":(3[5-9]|[45][0-9]|6[0-5])")))
       << r.out;
 }
 
