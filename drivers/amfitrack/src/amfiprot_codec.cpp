@@ -275,16 +275,16 @@ ParsedPayload decode_payload(const Packet& p) {
       const uint8_t* b = d.data();
       SensorMeasurement m;
       m.old_layout = old;
-      for (int i = 0; i < 3; ++i)
-        m.position_m[static_cast<size_t>(i)] = s24(b + 3 * i) * 1e-5;
-      for (int i = 0; i < 4; ++i)
-        m.quaternion_xyzw[static_cast<size_t>(i)] = s24(b + 9 + 3 * i) * 1e-6;
+      for (size_t i = 0; i < 3; ++i)
+        m.position_m[i] = s24(b + 3 * i) * 1e-5;
+      for (size_t i = 0; i < 4; ++i)
+        m.quaternion_xyzw[i] = s24(b + 9 + 3 * i) * 1e-6;
       m.sensor_status = b[21];
       m.tracked_source = b[22];
       m.calculation_id = u16(b + 23);
-      for (int i = 0; i < 3; ++i) {
-        m.accel_g[static_cast<size_t>(i)] = s16(b + 25 + 2 * i) * 4.0 / 32767.0;
-        m.gyro_dps[static_cast<size_t>(i)] = s16(b + 31 + 2 * i) * 0.070;
+      for (size_t i = 0; i < 3; ++i) {
+        m.accel_g[i] = s16(b + 25 + 2 * i) * 4.0 / 32767.0;
+        m.gyro_dps[i] = s16(b + 31 + 2 * i) * 0.070;
       }
       if (old) {
         m.pose_state_raw = b[37];
@@ -293,8 +293,8 @@ ParsedPayload decode_payload(const Packet& p) {
         m.rssi = static_cast<int8_t>(b[41]);
         m.frame_id = u24(b + 42);
       } else {
-        for (int i = 0; i < 3; ++i)
-          m.mag_ut[static_cast<size_t>(i)] = s16(b + 37 + 2 * i) * 400.0 / 32767.0;
+        for (size_t i = 0; i < 3; ++i)
+          m.mag_ut[i] = s16(b + 37 + 2 * i) * 400.0 / 32767.0;
         m.temperature_c = b[43] / 2.0 - 30.0;
         m.pose_state_raw = b[44];
         m.quality_raw = b[45];
