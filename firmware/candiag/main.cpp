@@ -175,8 +175,7 @@ std::string json_state(const sm::ScoutMini& d, Nanos now) {
       s.wheel_odometer
           ? fmt::format("[{},{}]", s.wheel_odometer->left_mm, s.wheel_odometer->right_mm)
           : std::string("null"),
-      motors, ids, hal::to_string(const_cast<sm::ScoutMini&>(d).bus().state()), bus.error_frames,
-      bus.write_errors);
+      motors, ids, hal::to_string(d.bus_state()), bus.error_frames, bus.write_errors);
 }
 
 std::string text_state(const sm::ScoutMini& d, Nanos now) {
@@ -208,7 +207,7 @@ std::string text_state(const sm::ScoutMini& d, Nanos now) {
   const auto c = d.counters();
   out += fmt::format(
       "bus {}  error frames {}  write errors {}  decode drops: wrong dlc {}, unknown id {}\n",
-      hal::to_string(const_cast<sm::ScoutMini&>(d).bus().state()), c.error_frames, c.write_errors,
+      hal::to_string(d.bus_state()), c.error_frames, c.write_errors,
       c.decode_errors[static_cast<size_t>(sm::DecodeError::kWrongDlc)],
       c.decode_errors[static_cast<size_t>(sm::DecodeError::kUnknownId)]);
   return out;
@@ -327,7 +326,7 @@ int run(int argc, char** argv) {
   auto opened = hal::open_can(bus_uri, clock,
                               whole_bus ? std::vector<uint32_t>{} : scout_mini::feedback_ids());
   if (!opened.bus) {
-    complain("cannot open %s: %s\n", bus_uri.c_str(), opened.error.c_str());
+    complain("cannot open the bus: %s\n", opened.error.c_str());  // the error names the URI
     return kExitNoBase;
   }
   hal::CanBus& bus = *opened.bus;

@@ -113,7 +113,7 @@ int run(int argc, char** argv) {
   if (base_uri != "none" && base_uri != "sim") {
     auto opened = hal::open_can(base_uri, clock, scout_mini::feedback_ids());
     if (!opened.bus) {
-      spdlog::error("base: cannot open {}: {}", base_uri, opened.error);
+      spdlog::error("base: cannot open it: {}", opened.error);  // the error names the URI
     } else if (!daemon.attach_base(std::move(opened.bus))) {
       spdlog::critical("task table: base and control tasks must share a rate group");
       firmware::shutdown_logging();

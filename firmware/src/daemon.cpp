@@ -43,7 +43,14 @@ Daemon::Daemon(const DaemonConfig& cfg, hal::SystemdNotifier& notifier)
       notifier_(notifier),
       supervisor_(supervisor_config(cfg)),
       watchdog_interval_(hal::SystemdNotifier::watchdog_interval()),
-      gate_(stop_limits(cfg)) {}
+      gate_(stop_limits(cfg)),
+      base_send_warning_(core::from_ms(cfg.logging.warning_interval_ms)) {}
+
+void Daemon::attach(const Executor& executor) {
+  executor_ = &executor;
+  const size_t control = executor.find("control");
+  control_stats_ = control < executor.task_count() ? &executor.stats(control) : nullptr;
+}
 
 std::vector<TaskBinding> Daemon::bindings() {
   std::vector<TaskBinding> out;
@@ -122,7 +129,14 @@ void Daemon::control_task(const core::Tick& tick) {
   command_.publish(cmd, tick.now);
   // Every path to the wheels passes the gate above; a zero command is still streamed (the base
   // stops by itself 500 ms after the last one).
-  if (base_) base_->command(cmd.vx_mps, cmd.vy_mps, cmd.wz_radps, tick.now);
+  if (base_) {
+    const hal::CanSendResult r = base_->command(cmd.vx_mps, cmd.vy_mps, cmd.wz_radps, tick.now);
+    if (r != hal::CanSendResult::kOk) {
+      // Repeats at 100 Hz while the bus is down: one line per interval, with the count.
+      base_send_warning_.warn(tick.now, "base: motion command not sent: {} (write errors {})",
+                              hal::to_string(r), base_->counters().write_errors);
+    }
+  }
 }
 
 // ---- supervisor ------------------------------------------------------------------------------
@@ -136,14 +150,11 @@ void Daemon::supervisor_task(const core::Tick& tick) {
     shutdown_seen_at_ns_.store(tick.now.count(), std::memory_order_release);
   }
 
-  if (executor_ != nullptr) {
-    const size_t control = executor_->find("control");
-    if (control < executor_->task_count()) {
-      const core::TaskStats& st = executor_->stats(control);
-      // Before the control task's first run, its heartbeat counts from start-up.
-      in.control_heartbeat = st.runs() > 0 ? st.last_end() : initialized_at_;
-      in.control_overruns = st.overruns();
-    }
+  if (control_stats_ != nullptr) {
+    // Before the control task's first run, its heartbeat counts from start-up.
+    in.control_heartbeat =
+        control_stats_->runs() > 0 ? control_stats_->last_end() : initialized_at_;
+    in.control_overruns = control_stats_->overruns();
   }
 
   if (const auto base = base_health_.read()) {

@@ -70,7 +70,7 @@ TEST(Candiag, ClearErrorsForNoBaseNoInterfaceAndV1) {
   EXPECT_NE(r.out.find("is the base powered on"), std::string::npos) << r.out;
   r = candiag({"--bus", "socketcan:can7", "check"});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.out.find("cannot open socketcan:can7"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("cannot open the bus: socketcan:can7"), std::string::npos) << r.out;
   r = candiag({"--bus", "virtual:cd5", "--sim", "--sim-v1", "check", "--seconds", "0.3"});
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.out.find("protocol V1"), std::string::npos) << r.out;

@@ -58,7 +58,7 @@ class Daemon {
   bool attach_base(std::unique_ptr<hal::CanBus> bus);
   [[nodiscard]] const core::LatestValue<BaseHealth>& base_health() const { return base_health_; }
   // The executor running the bindings (the supervisor and the report read its statistics).
-  void attach(const Executor& executor) { executor_ = &executor; }
+  void attach(const Executor& executor);
 
   // Start-up finished: devices open, tasks running (the supervisor leaves INIT).
   void mark_initialized() { initialized_.store(true, std::memory_order_release); }
@@ -92,6 +92,7 @@ class Daemon {
   DaemonConfig cfg_;
   hal::SystemdNotifier& notifier_;
   const Executor* executor_ = nullptr;
+  const core::TaskStats* control_stats_ = nullptr;  // resolved once in attach()
 
   std::atomic<bool> initialized_{false};
   std::atomic<bool> shutdown_{false};
@@ -112,6 +113,7 @@ class Daemon {
 
   // control task state
   core::MotionGate gate_;
+  RateLimitedLog base_send_warning_;
   core::LatestValue<core::BodyVelocity> command_;
 
   // report task state

@@ -1,5 +1,6 @@
 // companiond's task table and daemon on the simulated clock, with a real NOTIFY_SOCKET.
 #include <gtest/gtest.h>
+#include <spdlog/sinks/ringbuffer_sink.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -234,7 +235,9 @@ struct DaemonWithBase {
   // `script` runs in the world task at every 5 ms step, before the daemon's tasks.
   explicit DaemonWithBase(std::function<void(Nanos, DaemonWithBase&)> script = {})
       : daemon(defaults(), notifier), base_bus("daemon-base", clock), base(base_bus) {
-    EXPECT_TRUE(daemon.attach_base(std::make_unique<hal::VirtualCanBus>("daemon-base", clock)));
+    auto host = std::make_unique<hal::VirtualCanBus>("daemon-base", clock);
+    host_bus = host.get();
+    EXPECT_TRUE(daemon.attach_base(std::move(host)));
     auto tasks = daemon.bindings();
     tasks.push_back(
         {core::TaskSpec{"world", 200, 100, 0, 255}, [this, script](const core::Tick& t) {
@@ -258,6 +261,7 @@ struct DaemonWithBase {
   hal::SystemdNotifier notifier;
   firmware::Daemon daemon;
   hal::VirtualCanBus base_bus;
+  hal::VirtualCanBus* host_bus = nullptr;  // the daemon's end (owned by the daemon)
   sim::SimScoutMini base;
   std::unique_ptr<firmware::Executor> executor;
 };
@@ -314,4 +318,27 @@ TEST(DaemonWithBase, ShutdownCompletesOnlyOnceTheBaseReportsStandstill) {
   d.run_until(1600ms);
   EXPECT_FALSE(complete_before_feedback) << "zero commanded is not enough without the base's word";
   EXPECT_TRUE(d.daemon.shutdown_complete());
+}
+
+TEST(DaemonWithBase, FailedSendsAreWarnedAtMostOncePerInterval) {
+  // Capture the log lines (the default logger outside the daemon is synchronous).
+  auto ring = std::make_shared<spdlog::sinks::ringbuffer_sink_mt>(10000);
+  auto previous = spdlog::default_logger();
+  spdlog::set_default_logger(std::make_shared<spdlog::logger>("capture", ring));
+  DaemonWithBase d([](Nanos now, DaemonWithBase& w) {
+    if (now == 1s) w.host_bus->inject_bus_off(true);  // 0x111 fails at 100 Hz from here on
+  });
+  d.run_until(3500ms);
+  spdlog::set_default_logger(previous);
+  int warnings = 0;
+  bool counted = false;
+  for (const auto& line : ring->last_formatted()) {
+    if (line.find("base: motion command not sent: bus-off") == std::string::npos) continue;
+    ++warnings;
+    counted = counted || line.find("similar suppressed") != std::string::npos;
+  }
+  // 250 failed sends in 2.5 s, warning_interval_ms = 1000: three lines, not 250.
+  EXPECT_EQ(warnings, 3);
+  EXPECT_TRUE(counted) << "later lines say how many were held back";
+  EXPECT_TRUE(active(d.daemon.safety().read()->value, core::Reason::kCanBusOff));
 }

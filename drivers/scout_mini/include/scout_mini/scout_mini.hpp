@@ -104,7 +104,7 @@ class ScoutMini {
   [[nodiscard]] hal::Nanos last_feedback() const { return last_feedback_; }
   [[nodiscard]] bool feedback_silent(hal::Nanos now) const;
   [[nodiscard]] bool bus_off() const { return bus_.state() == hal::CanBusState::kBusOff; }
-  [[nodiscard]] hal::CanBus& bus() { return bus_; }
+  [[nodiscard]] hal::CanBusState bus_state() const { return bus_.state(); }
 
  private:
   void handle(const Feedback& msg, hal::Nanos stamp);
