@@ -157,6 +157,16 @@ std::vector<uint8_t> encode_packet(const Packet& p) {
   return out;
 }
 
+FramingStats& operator+=(FramingStats& a, const FramingStats& b) {
+  a.frames += b.frames;
+  a.bad_cobs += b.bad_cobs;
+  a.overlong += b.overlong;
+  a.bad_packet += b.bad_packet;
+  for (size_t i = 0; i < a.packet_errors.size(); ++i)
+    a.packet_errors[i] += b.packet_errors[i];
+  return a;
+}
+
 ParsedPacket parse_hid_report(std::span<const uint8_t> report) {
   // [report id][length byte][packet...]: the two prefix bytes are not trusted (nobody checks
   // them); the packet's own header and CRCs decide.

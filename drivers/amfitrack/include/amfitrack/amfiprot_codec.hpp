@@ -87,13 +87,16 @@ std::array<uint8_t, kHidReportSize> encode_hid_report(const Packet& p);
 std::vector<uint8_t> cobs_encode(std::span<const uint8_t> bytes);
 std::optional<std::vector<uint8_t>> cobs_decode(std::span<const uint8_t> encoded);
 
-struct CobsStats {
-  uint64_t frames = 0;
-  uint64_t bad_cobs = 0;    // frame with an invalid COBS structure
+// What a link's framing saw: COBS frames on a UART, input reports on HID.
+struct FramingStats {
+  uint64_t frames = 0;      // COBS frames / HID reports
+  uint64_t bad_cobs = 0;    // frame with an invalid COBS structure (UART only)
   uint64_t overlong = 0;    // garbage longer than any packet before a delimiter (resynchronised)
-  uint64_t bad_packet = 0;  // COBS fine, packet check failed (see packet_errors)
+  uint64_t bad_packet = 0;  // framing fine, packet check failed (see packet_errors)
   std::array<uint64_t, static_cast<size_t>(PacketError::kCount)> packet_errors{};
 };
+
+FramingStats& operator+=(FramingStats& a, const FramingStats& b);
 
 // Splits a UART byte stream at 0x00 delimiters and decodes packets; resynchronises at the next
 // delimiter after garbage or a torn frame.
@@ -101,14 +104,14 @@ class CobsStreamDecoder {
  public:
   void feed(std::span<const uint8_t> bytes);
   std::optional<Packet> next();
-  [[nodiscard]] const CobsStats& stats() const { return stats_; }
+  [[nodiscard]] const FramingStats& stats() const { return stats_; }
 
  private:
   std::vector<uint8_t> frame_;
   std::vector<Packet> ready_;
   size_t ready_head_ = 0;
   bool discarding_ = false;
-  CobsStats stats_;
+  FramingStats stats_;
 };
 
 // ---- payloads --------------------------------------------------------------------------------

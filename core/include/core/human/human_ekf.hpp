@@ -1,0 +1,102 @@
+#pragma once
+// The tracked person's planar state in `odom`: a Kalman filter with a constant-velocity model
+// in position and heading, state s = [x, y, theta, vx, vy, omega] (m, rad, m/s, rad/s).
+// Measurements: the tracker's person pose (already moved into odom with the robot's odometry at
+// the measurement time; heading optional) and, optionally, the worn sensor's yaw rate. Outliers
+// are rejected by a Mahalanobis gate; a run of rejections (the person really is elsewhere, e.g.
+// after a tracking gap) re-initialises the track. Pure: time is an argument; no allocation.
+#include <Eigen/Core>
+#include <cstdint>
+#include <optional>
+#include <span>
+
+#include "core/geometry/pose2.hpp"
+#include "core/time.hpp"
+
+namespace core {
+
+struct HumanEkfConfig {
+  double position_noise_m = 0.05;     // 1-sigma of one tracker position
+  double heading_noise_rad = 0.10;    // 1-sigma of one tracker heading
+  double yaw_rate_noise_radps = 0.2;  // 1-sigma of one gyro yaw rate
+  // White-noise acceleration of the constant-velocity model: the filter's bandwidth. Higher
+  // follows sudden stops faster, lower gives a smoother velocity (see test_human_ekf).
+  double accel_noise_mps2 = 0.5;
+  double yaw_accel_noise_radps2 = 2.0;
+  double gate_probability = 0.999;    // chi-square gate: 0.99, 0.995 or 0.999
+  uint32_t reset_after_rejects = 12;  // consecutive rejected poses (100 ms at 120 Hz)
+  Nanos reset_after_gap = std::chrono::milliseconds(1000);  // no accepted pose this long
+  double initial_speed_sigma_mps = 1.5;
+  double initial_yaw_rate_sigma_radps = 1.5;
+};
+
+using HumanVector = Eigen::Matrix<double, 6, 1>;
+using HumanCovariance = Eigen::Matrix<double, 6, 6>;
+
+// The filter's state at `stamp`: a plain value, published to other tasks, which predict it to
+// their own query time with predict_track().
+struct HumanTrack {
+  bool valid = false;
+  HumanVector mean = HumanVector::Zero();
+  HumanCovariance covariance = HumanCovariance::Identity();
+  Nanos stamp{0};        // time of `mean`
+  Nanos last_update{0};  // time of the latest accepted pose
+};
+
+struct HumanEkfCounters {
+  uint64_t updates = 0;
+  uint64_t rejected = 0;  // by the gate
+  uint64_t resets = 0;    // re-initialisations (the first one included)
+  uint64_t yaw_rate_updates = 0;
+  uint64_t invalid_inputs = 0;  // NaN/Inf measurements, time going backwards
+};
+
+enum class UpdateResult : uint8_t { kAccepted, kRejected, kReset, kInvalid };
+
+class HumanEkf {
+ public:
+  explicit HumanEkf(const HumanEkfConfig& config);
+
+  // Person pose in odom at `stamp`. `heading_valid` false: position only.
+  UpdateResult update_pose(const Pose2& person_in_odom, bool heading_valid, Nanos stamp);
+  // Yaw rate of the person (rad/s, about z) at `stamp`.
+  UpdateResult update_yaw_rate(double yaw_rate_radps, Nanos stamp);
+
+  [[nodiscard]] const HumanTrack& track() const { return track_; }
+  [[nodiscard]] const HumanEkfCounters& counters() const { return counters_; }
+  // Squared Mahalanobis distance of the latest pose innovation (for diagnostics).
+  [[nodiscard]] double last_nis() const { return last_nis_; }
+
+ private:
+  void predict_to(Nanos t);
+  void reset(const Pose2& z, bool heading_valid, Nanos stamp);
+
+  HumanEkfConfig config_;
+  HumanTrack track_;
+  HumanEkfCounters counters_;
+  uint32_t consecutive_rejects_ = 0;
+  double last_nis_ = 0;
+};
+
+// The track moved forward (or backward) to `t` with the model; covariance grows with |dt|.
+HumanTrack predict_track(const HumanTrack& track, Nanos t, const HumanEkfConfig& config);
+
+// Constant-velocity prediction of the person's pose at t0, t0 + dt, ... (out.size() poses).
+void predict_path(const HumanTrack& track, Nanos t0, double dt_s, std::span<Pose2> out);
+
+// What the planner and the controller consume.
+struct HumanState {
+  bool valid = false;
+  Pose2 pose_odom;
+  Point2 velocity_odom;  // m/s
+  double yaw_rate_radps = 0;
+  Pose2 pose_base;              // person in base_link
+  Point2 velocity_base;         // the person's velocity (over ground) in base_link axes
+  double position_sigma_m = 0;  // sqrt of the largest eigenvalue of the position covariance
+  double heading_sigma_rad = 0;
+  Nanos age{0};  // time since the latest accepted tracker pose
+};
+HumanState human_state(const HumanTrack& track, Nanos t, const Pose2& base_in_odom,
+                       const HumanEkfConfig& config);
+
+}  // namespace core

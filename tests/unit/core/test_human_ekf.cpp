@@ -1,0 +1,244 @@
+// The human estimator against a simulated walker (straight, turning, stopping, 0.7-1.7 m/s) with
+// the tracker's noise at 120 Hz: position error well below the noise, velocity converged within
+// a second, outliers rejected, prediction to query times.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <vector>
+
+#include "core/human/human_ekf.hpp"
+
+using core::Nanos;
+using core::Pose2;
+using namespace std::chrono_literals;
+
+namespace {
+
+constexpr double kSigmaPos = 0.05;
+constexpr double kSigmaHeading = 0.10;
+constexpr Nanos kFrame = Nanos(1'000'000'000 / 120);
+
+struct Truth {
+  Pose2 pose;
+  double vx = 0, vy = 0, w = 0;
+};
+
+// A walker: a list of (duration, speed, turn rate) legs, integrated exactly at 120 Hz.
+std::vector<Truth> walk(const std::vector<std::array<double, 3>>& legs) {
+  std::vector<Truth> out;
+  Truth t;
+  const double dt = core::to_seconds(kFrame);
+  for (const auto& [duration, speed, turn] : legs) {
+    const int n = static_cast<int>(std::lround(duration / dt));
+    for (int i = 0; i < n; ++i) {
+      t.vx = speed * std::cos(t.pose.theta_rad);
+      t.vy = speed * std::sin(t.pose.theta_rad);
+      t.w = turn;
+      out.push_back(t);
+      t.pose.x_m += t.vx * dt;
+      t.pose.y_m += t.vy * dt;
+      t.pose.theta_rad = core::wrap_angle(t.pose.theta_rad + turn * dt);
+    }
+  }
+  return out;
+}
+
+struct RunResult {
+  double rmse_pos = 0;       // after the first second
+  double rmse_heading = 0;   // after the first second
+  double rms_vel_error = 0;  // after the first second
+  core::HumanEkfCounters counters;
+};
+
+RunResult run(const std::vector<Truth>& truth, uint32_t seed, double outlier_rate = 0.0,
+              Nanos settle = 1s) {
+  core::HumanEkfConfig cfg;
+  cfg.position_noise_m = kSigmaPos;
+  cfg.heading_noise_rad = kSigmaHeading;
+  core::HumanEkf ekf(cfg);
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> npos(0, kSigmaPos);
+  std::normal_distribution<double> nhead(0, kSigmaHeading);
+  std::uniform_real_distribution<double> u(0, 1);
+  double se_pos = 0;
+  double se_head = 0;
+  double se_vel = 0;
+  int n = 0;
+  RunResult r;
+  for (size_t i = 0; i < truth.size(); ++i) {
+    const Nanos t = kFrame * static_cast<int64_t>(i);
+    Pose2 z{truth[i].pose.x_m + npos(rng), truth[i].pose.y_m + npos(rng),
+            core::wrap_angle(truth[i].pose.theta_rad + nhead(rng))};
+    if (u(rng) < outlier_rate) z.x_m += 1.5;  // a metal-distorted frame: 1.5 m off
+    ekf.update_pose(z, true, t);
+    if (t < settle) continue;
+    const auto& m = ekf.track().mean;
+    se_pos += std::pow(m(0) - truth[i].pose.x_m, 2) + std::pow(m(1) - truth[i].pose.y_m, 2);
+    se_head += std::pow(core::wrap_angle(m(2) - truth[i].pose.theta_rad), 2);
+    se_vel += std::pow(m(3) - truth[i].vx, 2) + std::pow(m(4) - truth[i].vy, 2);
+    ++n;
+  }
+  // Planar position RMSE per axis (comparable to the per-axis noise sigma).
+  r.rmse_pos = std::sqrt(se_pos / (2.0 * n));
+  r.rmse_heading = std::sqrt(se_head / n);
+  r.rms_vel_error = std::sqrt(se_vel / n);
+  r.counters = ekf.counters();
+  return r;
+}
+
+TEST(HumanEkf, StraightWalksAtEverySpeed) {
+  for (double speed : {0.7, 1.2, 1.7}) {
+    const auto r = run(walk({{10.0, speed, 0.0}}), 1);
+    EXPECT_LT(r.rmse_pos, 0.5 * kSigmaPos) << speed;
+    EXPECT_LT(r.rmse_heading, 0.5 * kSigmaHeading) << speed;
+    EXPECT_LT(r.rms_vel_error, 0.15) << "velocity converged within a second at " << speed;
+    EXPECT_EQ(r.counters.resets, 1U);
+  }
+}
+
+TEST(HumanEkf, TurningAndStopping) {
+  // Walk, turn 90 degrees in 2 s, stop (abruptly, as people do), walk again, turn the other way.
+  const auto truth = walk({{3.0, 1.2, 0.0},
+                           {2.0, 1.2, std::numbers::pi / 4},
+                           {2.0, 0.0, 0.0},
+                           {2.0, 0.9, 0.0},
+                           {2.0, 0.9, -0.8}});
+  const auto r = run(truth, 2);
+  EXPECT_LT(r.rmse_pos, 0.7 * kSigmaPos);
+  EXPECT_LT(r.rmse_heading, 0.7 * kSigmaHeading);
+  // A sudden stop is not an outlier: only the gate's own false-alarm rate (0.1 %) is rejected.
+  EXPECT_LE(r.counters.rejected, truth.size() / 200);
+  EXPECT_LT(r.rms_vel_error, 0.25);
+  EXPECT_EQ(r.counters.resets, 1U);
+}
+
+TEST(HumanEkf, VelocityConvergesWithinOneSecondOfAStop) {
+  // Stopping at t = 3 s: one second later the speed estimate is near zero again.
+  const auto truth = walk({{3.0, 1.5, 0.0}, {3.0, 0.0, 0.0}});
+  core::HumanEkf ekf(core::HumanEkfConfig{});
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n(0, kSigmaPos);
+  double se_after = 0;
+  int n_after = 0;
+  for (size_t i = 0; i < truth.size(); ++i) {
+    const Nanos t = kFrame * static_cast<int64_t>(i);
+    ekf.update_pose({truth[i].pose.x_m + n(rng), truth[i].pose.y_m + n(rng), 0.0}, true, t);
+    if (t >= 4s) {
+      se_after += std::pow(ekf.track().mean(3), 2) + std::pow(ekf.track().mean(4), 2);
+      ++n_after;
+    }
+  }
+  EXPECT_LT(std::sqrt(se_after / n_after), 0.15);
+  EXPECT_EQ(ekf.counters().resets, 1U) << "followed, not re-initialised";
+}
+
+TEST(HumanEkf, RejectsOutliers) {
+  const auto truth = walk({{10.0, 1.2, 0.2}});
+  const auto clean = run(truth, 4, 0.0);
+  const auto dirty = run(truth, 4, 0.05);
+  EXPECT_GT(dirty.counters.rejected, 30U);
+  EXPECT_EQ(dirty.counters.resets, 1U) << "isolated outliers never reset the track";
+  EXPECT_LT(dirty.rmse_pos, 0.7 * kSigmaPos);
+  EXPECT_LT(dirty.rmse_pos, clean.rmse_pos + 0.01);
+}
+
+TEST(HumanEkf, ARealJumpResetsTheTrackAfterTheConfiguredRejections) {
+  core::HumanEkfConfig cfg;
+  cfg.reset_after_rejects = 5;
+  core::HumanEkf ekf(cfg);
+  Nanos t{0};
+  for (int i = 0; i < 120; ++i, t += kFrame)
+    ekf.update_pose({0, 0, 0}, true, t);
+  for (int i = 0; i < 4; ++i, t += kFrame) {
+    EXPECT_EQ(ekf.update_pose({3, 0, 0}, true, t), core::UpdateResult::kRejected);
+  }
+  EXPECT_EQ(ekf.update_pose({3, 0, 0}, true, t), core::UpdateResult::kReset);
+  EXPECT_DOUBLE_EQ(ekf.track().mean(0), 3.0);
+  EXPECT_EQ(ekf.counters().resets, 2U);
+  // After a long silence, the first pose restarts the track instead of being gated.
+  t += 2s;
+  EXPECT_EQ(ekf.update_pose({-4, 1, 0}, true, t), core::UpdateResult::kReset);
+}
+
+TEST(HumanEkf, InvalidInputChangesNothing) {
+  core::HumanEkf ekf(core::HumanEkfConfig{});
+  ekf.update_pose({1, 2, 0.5}, true, 100ms);
+  const auto before = ekf.track();
+  EXPECT_EQ(ekf.update_pose({std::nan(""), 0, 0}, true, 110ms), core::UpdateResult::kInvalid);
+  EXPECT_EQ(ekf.update_pose({1, 2, 0.5}, true, 50ms), core::UpdateResult::kInvalid)
+      << "time going backwards";
+  EXPECT_EQ(ekf.update_yaw_rate(std::numeric_limits<double>::infinity(), 120ms),
+            core::UpdateResult::kInvalid);
+  EXPECT_EQ(ekf.track().mean, before.mean);
+  EXPECT_EQ(ekf.counters().invalid_inputs, 3U);
+}
+
+TEST(HumanEkf, WithoutHeadingOnlyThePositionIsUpdated) {
+  core::HumanEkf ekf(core::HumanEkfConfig{});
+  ekf.update_pose({0, 0, 1.0}, true, 0ms);
+  for (int i = 1; i < 60; ++i) {
+    ekf.update_pose({0.01 * i, 0, -2.0}, false, kFrame * i);  // the heading value is ignored
+  }
+  EXPECT_NEAR(ekf.track().mean(2), 1.0, 0.05);
+  EXPECT_NEAR(ekf.track().mean(0), 0.59, 0.05);
+}
+
+TEST(HumanEkf, GyroYawRateSharpensTheTurnRate) {
+  const auto truth = walk({{4.0, 1.0, 0.6}});
+  core::HumanEkf with_gyro(core::HumanEkfConfig{});
+  core::HumanEkf without(core::HumanEkfConfig{});
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n(0, kSigmaPos);
+  std::normal_distribution<double> nh(0, kSigmaHeading);
+  std::normal_distribution<double> ng(0, 0.05);
+  double se_with = 0;
+  double se_without = 0;
+  for (size_t i = 0; i < truth.size(); ++i) {
+    const Nanos t = kFrame * static_cast<int64_t>(i);
+    const Pose2 z{truth[i].pose.x_m + n(rng), truth[i].pose.y_m + n(rng),
+                  truth[i].pose.theta_rad + nh(rng)};
+    with_gyro.update_pose(z, true, t);
+    without.update_pose(z, true, t);
+    with_gyro.update_yaw_rate(0.6 + ng(rng), t);
+    if (t > 1s) {
+      se_with += std::pow(with_gyro.track().mean(5) - 0.6, 2);
+      se_without += std::pow(without.track().mean(5) - 0.6, 2);
+    }
+  }
+  EXPECT_LT(se_with, 0.25 * se_without);
+  EXPECT_GT(with_gyro.counters().yaw_rate_updates, 400U);
+}
+
+TEST(HumanEkf, PredictsToQueryTimesAndIntoTheRobotFrame) {
+  core::HumanTrack track;
+  track.valid = true;
+  track.mean << 1.0, 2.0, 0.0, 1.0, 0.5, 0.1;
+  track.covariance = core::HumanCovariance::Identity() * 0.01;
+  track.stamp = 1s;
+  track.last_update = 1s;
+  std::array<Pose2, 3> path;
+  core::predict_path(track, 1500ms, 0.1, path);
+  EXPECT_NEAR(path[0].x_m, 1.5, 1e-12);
+  EXPECT_NEAR(path[2].x_m, 1.7, 1e-12);
+  EXPECT_NEAR(path[2].y_m, 2.35, 1e-12);
+  EXPECT_NEAR(path[2].theta_rad, 0.07, 1e-12);
+
+  const core::HumanEkfConfig cfg;
+  const Pose2 base_in_odom{1.0, 0.0, std::numbers::pi / 2};  // robot at (1, 0) facing +y
+  const auto h = core::human_state(track, 2s, base_in_odom, cfg);
+  ASSERT_TRUE(h.valid);
+  EXPECT_NEAR(h.pose_odom.x_m, 2.0, 1e-12);
+  EXPECT_NEAR(h.pose_odom.y_m, 2.5, 1e-12);
+  // In base_link: 2.5 m ahead, 1 m to the right; walking (1, 0.5) in odom = (0.5, -1) in base.
+  EXPECT_NEAR(h.pose_base.x_m, 2.5, 1e-12);
+  EXPECT_NEAR(h.pose_base.y_m, -1.0, 1e-12);
+  EXPECT_NEAR(h.pose_base.theta_rad, 0.1 - std::numbers::pi / 2, 1e-12);
+  EXPECT_NEAR(h.velocity_base.x_m, 0.5, 1e-12);
+  EXPECT_NEAR(h.velocity_base.y_m, -1.0, 1e-12);
+  EXPECT_EQ(h.age, 1s);
+  EXPECT_GT(h.position_sigma_m, 0.1) << "uncertainty grows with the prediction";
+}
+
+}  // namespace
