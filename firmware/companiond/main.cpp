@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <iostream>
 
+#include "amfitrack/open_link.hpp"
 #include "firmware/config/config_loader.hpp"
 #include "firmware/daemon.hpp"
 #include "firmware/logging.hpp"
@@ -123,6 +124,24 @@ int run(int argc, char** argv) {
     }
   } else if (base_uri == "sim") {
     spdlog::warn("base: 'sim' needs the simulated world (issue 7); no base attached");
+  }
+  // The tracker's link: opened (and reopened after an unplug, with back-off) by the tracker task
+  // itself, so a missing tracker at boot is a HOLD with a reason, not a failed start.
+  const std::string& tracker_uri = cfg.devices.tracker;
+  if (tracker_uri != "none" && tracker_uri != "sim") {
+    std::string error;
+    const auto uri = amfitrack::parse_link_uri(tracker_uri, &error);
+    if (!uri) {  // the config loader checks this too; kept for a clear message
+      spdlog::critical("{}", error);
+      firmware::shutdown_logging();
+      return 1;
+    }
+    daemon.attach_tracker(std::make_unique<amfitrack::ReconnectingLink>(
+        [u = *uri]() { return amfitrack::open_link(u); }, firmware::tracker_reconnect_config(cfg)));
+    spdlog::info("tracker: Amfitrack on {} (sensor TX id {})", tracker_uri,
+                 cfg.tracker.sensor_tx_id);
+  } else if (tracker_uri == "sim") {
+    spdlog::warn("tracker: 'sim' needs the simulated world (issue 7); no tracker attached");
   }
   firmware::Executor executor(clock, firmware::group_table(), daemon.bindings());
   daemon.attach(executor);

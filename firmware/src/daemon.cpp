@@ -38,11 +38,76 @@ core::StopLimits stop_limits(const DaemonConfig& cfg) {
                           core::from_ms(cfg.supervisor.stop_max_time_ms)};
 }
 
+amfitrack::AmfitrackConfig amfitrack_config(const DaemonConfig& cfg) {
+  const auto& t = cfg.tracker;
+  amfitrack::AmfitrackConfig c;
+  c.sensor_tx_id = static_cast<uint8_t>(t.sensor_tx_id);
+  c.keepalive_period = core::from_ms(t.keepalive_period_ms);
+  c.gate.quality_high_is_good = t.quality_high_is_good;
+  c.gate.quality_bad_below = static_cast<uint8_t>(t.quality_bad_below);
+  c.gate.quality_good_min = static_cast<uint8_t>(t.quality_good_min);
+  c.gate.quaternion_norm_tolerance = t.quaternion_norm_tolerance;
+  c.gate.max_age = core::from_ms(t.max_age_ms);
+  c.gate.recover_frames = static_cast<uint32_t>(t.recover_frames);
+  return c;
+}
+
+amfitrack::TrackerExtrinsics tracker_extrinsics(const DaemonConfig& cfg) {
+  const auto& t = cfg.tracker;
+  return amfitrack::TrackerExtrinsics{
+      {t.source_x_m, t.source_y_m, t.source_z_m},
+      {t.source_roll_rad, t.source_pitch_rad, t.source_yaw_rad},
+      {t.sensor_in_body_roll_rad, t.sensor_in_body_pitch_rad, t.sensor_in_body_yaw_rad}};
+}
+
+amfitrack::ReconnectConfig tracker_reconnect_config(const DaemonConfig& cfg) {
+  return amfitrack::ReconnectConfig{core::from_ms(cfg.tracker.reconnect_first_ms),
+                                    core::from_ms(cfg.tracker.reconnect_max_ms)};
+}
+
+core::HumanEkfConfig human_ekf_config(const DaemonConfig& cfg) {
+  const auto& h = cfg.human;
+  core::HumanEkfConfig c;
+  c.position_noise_m = h.position_noise_m;
+  c.heading_noise_rad = h.heading_noise_rad;
+  c.yaw_rate_noise_radps = h.yaw_rate_noise_radps;
+  c.accel_noise_mps2 = h.accel_noise_mps2;
+  c.yaw_accel_noise_radps2 = h.yaw_accel_noise_radps2;
+  c.gate_probability = h.gate_probability;
+  c.reset_after_rejects = static_cast<uint32_t>(h.reset_after_rejects);
+  c.reset_after_gap = core::from_ms(h.reset_after_gap_ms);
+  return c;
+}
+
+core::TrackerConfidence to_tracker_confidence(amfitrack::Confidence c) {
+  switch (c) {
+    case amfitrack::Confidence::kGood:
+      return core::TrackerConfidence::kGood;
+    case amfitrack::Confidence::kDegraded:
+      return core::TrackerConfidence::kDegraded;
+    case amfitrack::Confidence::kBad:
+      return core::TrackerConfidence::kBad;
+  }
+  return core::TrackerConfidence::kUnknown;
+}
+
+namespace {
+// Odometry kept for placing tracker frames: 64 poses at 50 Hz = 1.3 s; a frame newer than the
+// newest pose uses it for up to 40 ms (two base periods).
+constexpr size_t kOdomHistory = 64;
+constexpr Nanos kOdomHold = std::chrono::milliseconds(40);
+}  // namespace
+
 Daemon::Daemon(const DaemonConfig& cfg, hal::SystemdNotifier& notifier)
     : cfg_(cfg),
       notifier_(notifier),
       supervisor_(supervisor_config(cfg)),
       watchdog_interval_(hal::SystemdNotifier::watchdog_interval()),
+      person_frame_(tracker_extrinsics(cfg)),
+      human_config_(human_ekf_config(cfg)),
+      human_ekf_(human_config_),
+      odom_history_(kOdomHistory, kOdomHold),
+      tracker_warning_(core::from_ms(cfg.logging.warning_interval_ms)),
       gate_(stop_limits(cfg)),
       base_send_warning_(core::from_ms(cfg.logging.warning_interval_ms)) {}
 
@@ -75,9 +140,87 @@ bool Daemon::shutdown_complete() const {
          b->value.vx_mps == 0.0 && b->value.vy_mps == 0.0 && b->value.wz_radps == 0.0;
 }
 
-// ---- input tasks: empty until their drivers land (the table's `pending` says so) ------------
+// ---- tracker: Amfitrack frames -> gate -> person in base_link -> human filter in odom ---------
 
-void Daemon::tracker_task(const core::Tick& /*tick*/) {}
+void Daemon::attach_tracker(std::unique_ptr<amfitrack::PacketLink> link) {
+  tracker_link_ = std::move(link);
+  tracker_ = std::make_unique<amfitrack::Amfitrack>(*tracker_link_, amfitrack_config(cfg_));
+}
+
+void Daemon::tracker_link_events(Nanos now) {
+  const auto* rl = dynamic_cast<const amfitrack::ReconnectingLink*>(tracker_link_.get());
+  const bool up = !tracker_link_->failed();
+  if (up != tracker_link_was_up_) {
+    if (up) {
+      spdlog::info("tracker: link up: {}", rl != nullptr ? rl->events().description : "");
+    } else {
+      spdlog::warn("tracker: link lost ({}); reopening with back-off",
+                   rl != nullptr ? rl->events().last_error : std::string("read/write error"));
+    }
+    tracker_link_was_up_ = up;
+  }
+  if (rl != nullptr && rl->events().open_failures != tracker_open_failures_seen_) {
+    tracker_open_failures_seen_ = rl->events().open_failures;
+    tracker_warning_.warn(now, "tracker: cannot open: {} (attempt {}, next in back-off)",
+                          rl->events().last_error, tracker_open_failures_seen_);
+  }
+}
+
+void Daemon::tracker_task(const core::Tick& tick) {
+  if (!tracker_) return;
+  tracker_->poll(tick.now);
+  tracker_link_events(tick.now);
+
+  // Where the robot was when each frame arrived (wheel odometry; identity without a base).
+  if (const auto b = base_health_.read(); b && b->value.odom_stamp != core::kNever) {
+    odom_history_.add(b->value.odom, b->value.odom_stamp);
+  }
+  TrackerHealth h;
+  for (const amfitrack::StampedMeasurement& sm : tracker_->new_measurements()) {
+    const auto person = person_frame_.to_base(sm.m);
+    if (!person) continue;
+    h.person_distance_m = person->distance_m;
+    // A frame the gate calls BAD (no tracking, distorted field) is not a measurement.
+    if (sm.confidence == amfitrack::Confidence::kBad) continue;
+    core::Pose2 base_in_odom;
+    if (base_) {
+      const auto at = odom_history_.at(sm.stamp);
+      if (!at) continue;  // no odometry near this frame: cannot place it in odom
+      base_in_odom = *at;
+    }
+    const core::Pose2 person_in_odom =
+        base_in_odom * core::Pose2{person->x_m, person->y_m, person->heading_rad};
+    human_ekf_.update_pose(person_in_odom, person->heading_valid, sm.stamp);
+    if (cfg_.human.use_gyro) human_ekf_.update_yaw_rate(person->yaw_rate_radps, sm.stamp);
+  }
+  if (!tracker_->new_measurements().empty()) {
+    human_track_.publish(human_ekf_.track(), tick.now);
+  }
+
+  const amfitrack::GateOutput gate = tracker_->confidence(tick.now);
+  if (const auto& latest = tracker_->latest()) {
+    h.frame_stamp = latest->stamp;
+    if (std::isnan(h.person_distance_m)) {
+      if (const auto p = person_frame_.to_base(latest->m)) h.person_distance_m = p->distance_m;
+    }
+  }
+  h.confidence = to_tracker_confidence(gate.confidence);
+  h.gate_reason = gate.reason;
+  h.quality = gate.quality;
+  h.rate_hz = tracker_->rate_hz();
+  h.link_up = !tracker_->link_failed();
+  const auto& c = tracker_->counters();
+  h.frames = c.poses;
+  h.dropped_frames = c.dropped_frames;
+  const amfitrack::FramingStats fs = tracker_link_->framing_stats();
+  h.decode_errors = fs.bad_cobs + fs.overlong + fs.bad_packet;
+  for (uint64_t e : c.payload_errors)
+    h.decode_errors += e;
+  h.filter_rejected = human_ekf_.counters().rejected;
+  h.filter_resets = human_ekf_.counters().resets;
+  tracker_health_.publish(h, tick.now);
+}
+
 bool Daemon::attach_base(std::unique_ptr<hal::CanBus> bus) {
   uint8_t base_group = 0;
   uint8_t control_group = 1;
@@ -112,6 +255,8 @@ void Daemon::base_task(const core::Tick& tick) {
   h.vx_mps = st.velocity.vx_mps;
   h.vy_mps = st.velocity.vy_mps;
   h.wz_radps = st.velocity.wz_radps;
+  h.odom = core::Pose2{st.odom.x_m, st.odom.y_m, st.odom.theta_rad};
+  h.odom_stamp = base_->odom_stamp() == Nanos(0) ? core::kNever : base_->odom_stamp();
   base_health_.publish(h, tick.now);
 }
 void Daemon::lidar_task(const core::Tick& /*tick*/) {}
@@ -155,6 +300,15 @@ void Daemon::supervisor_task(const core::Tick& tick) {
     in.control_heartbeat =
         control_stats_->runs() > 0 ? control_stats_->last_end() : initialized_at_;
     in.control_overruns = control_stats_->overruns();
+  }
+
+  if (const auto t = tracker_health_.read()) {
+    const TrackerHealth& h = t->value;
+    in.tracker_stamp = h.frame_stamp;
+    in.tracker_confidence = h.confidence;
+    in.tracker_detail = amfitrack::to_string(h.gate_reason).data();  // static text
+    in.tracker_quality = h.quality;
+    in.person_distance_m = h.person_distance_m;
   }
 
   if (const auto base = base_health_.read()) {

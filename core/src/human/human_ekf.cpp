@@ -36,10 +36,10 @@ double innovation_nis(const HumanTrack& t, const std::array<int, M>& rows,
                       const Eigen::Matrix<double, M, 1>& z, const Eigen::Matrix<double, M, M>& r,
                       Eigen::Matrix<double, M, 1>& nu, Eigen::Matrix<double, M, M>& s) {
   for (int i = 0; i < M; ++i) {
-    nu(i) = z(i) - t.mean(rows[static_cast<size_t>(i)]);
+    nu(i) = z(i) - t.mean()(rows[static_cast<size_t>(i)]);
     if (rows[static_cast<size_t>(i)] == 2) nu(i) = wrap_angle(nu(i));
     for (int j = 0; j < M; ++j) {
-      s(i, j) = t.covariance(rows[static_cast<size_t>(i)], rows[static_cast<size_t>(j)]);
+      s(i, j) = t.covariance()(rows[static_cast<size_t>(i)], rows[static_cast<size_t>(j)]);
     }
   }
   s += r;
@@ -54,13 +54,13 @@ void apply_update(HumanTrack& t, const std::array<int, M>& rows,
   Eigen::Matrix<double, M, 6> h = Eigen::Matrix<double, M, 6>::Zero();
   for (int i = 0; i < M; ++i)
     h(i, rows[static_cast<size_t>(i)]) = 1.0;
-  const Eigen::Matrix<double, 6, M> pht = t.covariance * h.transpose();
+  const Eigen::Matrix<double, 6, M> pht = t.covariance() * h.transpose();
   const Eigen::Matrix<double, 6, M> k = pht * s.inverse();
-  t.mean += k * nu;
-  t.mean(2) = wrap_angle(t.mean(2));
+  t.mean() += k * nu;
+  t.mean()(2) = wrap_angle(t.mean()(2));
   const HumanCovariance ikh = HumanCovariance::Identity() - k * h;
-  t.covariance = ikh * t.covariance * ikh.transpose() + k * r * k.transpose();
-  t.covariance = 0.5 * (t.covariance + t.covariance.transpose());
+  const HumanCovariance c = ikh * t.covariance() * ikh.transpose() + k * r * k.transpose();
+  t.covariance() = 0.5 * (c + c.transpose());  // (a temporary: no aliasing with the transpose)
 }
 
 }  // namespace
@@ -72,8 +72,8 @@ HumanTrack predict_track(const HumanTrack& track, Nanos t, const HumanEkfConfig&
   if (dt == 0.0) return out;
   HumanCovariance f = HumanCovariance::Identity();
   f(0, 3) = f(1, 4) = f(2, 5) = dt;
-  out.mean = f * track.mean;
-  out.mean(2) = wrap_angle(out.mean(2));
+  out.mean() = f * track.mean();
+  out.mean()(2) = wrap_angle(out.mean()(2));
   // Continuous white-noise acceleration, integrated over |dt|.
   const double a = std::abs(dt);
   const double q3 = a * a * a / 3.0;
@@ -89,7 +89,7 @@ HumanTrack predict_track(const HumanTrack& track, Nanos t, const HumanEkfConfig&
     q(i, i + 3) = q(i + 3, i) = q2 * sd;
     q(i + 3, i + 3) = a * sd;
   }
-  out.covariance = f * track.covariance * f.transpose() + q;
+  out.covariance() = f * track.covariance() * f.transpose() + q;
   out.stamp = t;
   return out;
 }
@@ -98,8 +98,8 @@ void predict_path(const HumanTrack& track, Nanos t0, double dt_s, std::span<Pose
   const double t0_s = to_seconds(t0 - track.stamp);
   for (size_t k = 0; k < out.size(); ++k) {
     const double t = t0_s + dt_s * static_cast<double>(k);
-    out[k] = Pose2{track.mean(0) + track.mean(3) * t, track.mean(1) + track.mean(4) * t,
-                   wrap_angle(track.mean(2) + track.mean(5) * t)};
+    out[k] = Pose2{track.mean()(0) + track.mean()(3) * t, track.mean()(1) + track.mean()(4) * t,
+                   wrap_angle(track.mean()(2) + track.mean()(5) * t)};
   }
 }
 
@@ -111,16 +111,16 @@ void HumanEkf::predict_to(Nanos t) {
 
 void HumanEkf::reset(const Pose2& z, bool heading_valid, Nanos stamp) {
   track_.valid = true;
-  track_.mean << z.x_m, z.y_m, heading_valid ? wrap_angle(z.theta_rad) : 0.0, 0, 0, 0;
-  track_.covariance.setZero();
+  track_.mean() << z.x_m, z.y_m, heading_valid ? wrap_angle(z.theta_rad) : 0.0, 0, 0, 0;
+  track_.covariance_data.fill(0.0);
   const double sp = config_.position_noise_m * config_.position_noise_m;
-  track_.covariance(0, 0) = track_.covariance(1, 1) = sp;
+  track_.covariance()(0, 0) = track_.covariance()(1, 1) = sp;
   // Without a heading, the heading is unknown: a wide prior (a full turn).
-  track_.covariance(2, 2) =
+  track_.covariance()(2, 2) =
       heading_valid ? config_.heading_noise_rad * config_.heading_noise_rad : 10.0;
-  track_.covariance(3, 3) = track_.covariance(4, 4) =
+  track_.covariance()(3, 3) = track_.covariance()(4, 4) =
       config_.initial_speed_sigma_mps * config_.initial_speed_sigma_mps;
-  track_.covariance(5, 5) =
+  track_.covariance()(5, 5) =
       config_.initial_yaw_rate_sigma_radps * config_.initial_yaw_rate_sigma_radps;
   track_.stamp = stamp;
   track_.last_update = stamp;
@@ -204,16 +204,16 @@ HumanState human_state(const HumanTrack& track, Nanos t, const Pose2& base_in_od
   if (!track.valid) return h;
   const HumanTrack p = predict_track(track, t, config);
   h.valid = true;
-  h.pose_odom = Pose2{p.mean(0), p.mean(1), p.mean(2)};
-  h.velocity_odom = Point2{p.mean(3), p.mean(4)};
-  h.yaw_rate_radps = p.mean(5);
+  h.pose_odom = Pose2{p.mean()(0), p.mean()(1), p.mean()(2)};
+  h.velocity_odom = Point2{p.mean()(3), p.mean()(4)};
+  h.yaw_rate_radps = p.mean()(5);
   const Pose2 odom_in_base = base_in_odom.inverse();
   h.pose_base = odom_in_base * h.pose_odom;
   h.velocity_base = odom_in_base.rotate(h.velocity_odom);
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(p.covariance.topLeftCorner<2, 2>(),
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(p.covariance().topLeftCorner<2, 2>(),
                                                            Eigen::EigenvaluesOnly);
   h.position_sigma_m = std::sqrt(std::max(0.0, eig.eigenvalues()(1)));
-  h.heading_sigma_rad = std::sqrt(std::max(0.0, p.covariance(2, 2)));
+  h.heading_sigma_rad = std::sqrt(std::max(0.0, p.covariance()(2, 2)));
   h.age = t - track.last_update;
   return h;
 }

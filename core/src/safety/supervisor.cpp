@@ -110,8 +110,10 @@ void Supervisor::describe(const SafetyInputs& in, Nanos now, Reason r,
                           age_ms(in.tracker_stamp, now), to_ms(config_.tracker_timeout));
       break;
     case Reason::kTrackerConfidenceLow:
-      (void)std::snprintf(buf, n, "tracker confidence %s, age %.1f ms",
-                          confidence_name(in.tracker_confidence), age_ms(in.tracker_stamp, now));
+      (void)std::snprintf(buf, n, "tracker confidence %s (%s), quality %d, age %.1f ms",
+                          confidence_name(in.tracker_confidence),
+                          in.tracker_detail != nullptr ? in.tracker_detail : "", in.tracker_quality,
+                          age_ms(in.tracker_stamp, now));
       break;
     case Reason::kPersonLost:
       (void)std::snprintf(buf, n, "person distance %.2f m > %.2f m", in.person_distance_m,

@@ -26,14 +26,10 @@ void Amfitrack::on_pose(const SensorMeasurement& m, hal::Nanos stamp) {
     const bool forward = gap > 0 && gap < 0x800000;
     if (!forward) ++counters_.repeated_frames;
     if (forward && gap > 1) counters_.dropped_frames += gap - 1;
-    if (forward && stamp > latest_->stamp) {
-      // Rate from the reception times, per frame id step (so drops do not read as a slow rate).
-      const double hz = 1e9 * gap / static_cast<double>((stamp - latest_->stamp).count());
-      rate_hz_ = rate_hz_ == 0 ? hz : 0.95 * rate_hz_ + 0.05 * hz;
-    }
+    if (forward) rate_window_ids_ += gap;
   }
   gate_.on_frame(m, stamp);
-  latest_ = StampedMeasurement{m, stamp};
+  latest_ = StampedMeasurement{m, stamp, gate_.evaluate(stamp).confidence};
   if (fresh_.size() < kMaxFramesPerPoll) fresh_.push_back(*latest_);
   ++counters_.poses;
 }
@@ -79,6 +75,19 @@ void Amfitrack::poll(hal::Nanos now) {
       }
     } else {
       on_reply(*p, *pl.payload, now);
+    }
+  }
+  // Rate: frame-id steps over the reception time of a window of polls. Frames arriving in bursts
+  // (USB, scheduling) share a reception stamp; the window averages that out.
+  if (!fresh_.empty()) {
+    if (!rate_window_open_) {
+      rate_window_open_ = true;
+      rate_window_start_ = now;
+      rate_window_ids_ = 0;
+    } else if (now - rate_window_start_ >= kRateWindow) {
+      rate_hz_ = 1e9 * rate_window_ids_ / static_cast<double>((now - rate_window_start_).count());
+      rate_window_start_ = now;
+      rate_window_ids_ = 0;
     }
   }
   if (link_.failed()) return;  // nothing to keep alive; the link reconnects by itself

@@ -8,7 +8,11 @@
 #include <string>
 #include <vector>
 
+#include "amfitrack/amfitrack.hpp"
+#include "amfitrack/person_frame.hpp"
 #include "core/channel/latest_value.hpp"
+#include "core/geometry/pose_history.hpp"
+#include "core/human/human_ekf.hpp"
 #include "core/safety/motion_gate.hpp"
 #include "core/safety/supervisor.hpp"
 #include "firmware/config/daemon_config.hpp"
@@ -41,10 +45,34 @@ struct BaseHealth {
   bool can_mode = false;
   uint64_t write_errors = 0;
   double vx_mps = 0, vy_mps = 0, wz_radps = 0;  // measured
+  core::Pose2 odom;                             // odom -> base_link from the wheels
+  core::Nanos odom_stamp = core::kNever;        // time of `odom`
+};
+
+// What the tracker task publishes: the gate's verdict and the link's health (the person's state
+// itself travels as a core::HumanTrack).
+struct TrackerHealth {
+  core::Nanos frame_stamp = core::kNever;  // latest frame of the configured sensor
+  core::TrackerConfidence confidence = core::TrackerConfidence::kUnknown;
+  amfitrack::GateReason gate_reason = amfitrack::GateReason::kNoData;
+  uint8_t quality = 0;  // effective (polarity applied)
+  double person_distance_m = std::numeric_limits<double>::quiet_NaN();  // planar, base_link
+  double rate_hz = 0;                                                   // measured frame rate
+  bool link_up = false;
+  uint64_t frames = 0;
+  uint64_t dropped_frames = 0;   // frame-id gaps
+  uint64_t decode_errors = 0;    // framing + payload
+  uint64_t filter_rejected = 0;  // poses the human filter gated out
+  uint64_t filter_resets = 0;
 };
 
 core::SupervisorConfig supervisor_config(const DaemonConfig& cfg);
 core::StopLimits stop_limits(const DaemonConfig& cfg);
+amfitrack::AmfitrackConfig amfitrack_config(const DaemonConfig& cfg);
+amfitrack::TrackerExtrinsics tracker_extrinsics(const DaemonConfig& cfg);
+amfitrack::ReconnectConfig tracker_reconnect_config(const DaemonConfig& cfg);
+core::HumanEkfConfig human_ekf_config(const DaemonConfig& cfg);
+core::TrackerConfidence to_tracker_confidence(amfitrack::Confidence c);
 
 class Daemon {
  public:
@@ -57,6 +85,16 @@ class Daemon {
   // they must be in one rate group: returns false (refuse to start) otherwise.
   bool attach_base(std::unique_ptr<hal::CanBus> bus);
   [[nodiscard]] const core::LatestValue<BaseHealth>& base_health() const { return base_health_; }
+  // The Amfitrack link (optional: without it the supervisor holds, tracker silent). Must be
+  // called before the executor starts.
+  void attach_tracker(std::unique_ptr<amfitrack::PacketLink> link);
+  [[nodiscard]] const core::LatestValue<TrackerHealth>& tracker_health() const {
+    return tracker_health_;
+  }
+  [[nodiscard]] const core::LatestValue<core::HumanTrack>& human_track() const {
+    return human_track_;
+  }
+  [[nodiscard]] const core::HumanEkfConfig& human_config() const { return human_config_; }
   // The executor running the bindings (the supervisor and the report read its statistics).
   void attach(const Executor& executor);
 
@@ -105,6 +143,20 @@ class Daemon {
   core::Nanos last_watchdog_ping_ = core::kNever;
   std::optional<std::chrono::microseconds> watchdog_interval_;
   core::LatestValue<SafetySnapshot> safety_;
+
+  // tracker (driver, extrinsics and filter owned by the tracker task)
+  void tracker_link_events(core::Nanos now);
+  std::unique_ptr<amfitrack::PacketLink> tracker_link_;
+  std::unique_ptr<amfitrack::Amfitrack> tracker_;
+  amfitrack::PersonFrame person_frame_;
+  core::HumanEkfConfig human_config_;
+  core::HumanEkf human_ekf_;
+  core::PoseHistory odom_history_;
+  bool tracker_link_was_up_ = false;
+  uint64_t tracker_open_failures_seen_ = 0;
+  RateLimitedLog tracker_warning_;
+  core::LatestValue<TrackerHealth> tracker_health_;
+  core::LatestValue<core::HumanTrack> human_track_;
 
   // base (driver owned by the realtime group's thread: base and control tasks)
   std::unique_ptr<hal::CanBus> base_bus_;

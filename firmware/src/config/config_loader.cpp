@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include "amfitrack/open_link.hpp"
 #include "schema.hpp"
 
 namespace firmware {
@@ -178,6 +179,36 @@ bool apply_defaults(DaemonConfig& cfg, std::vector<ConfigError>& errors) {
   return errors.empty();
 }
 
+// 1-based line of a dotted key in the document, 0 when it is not there (a default).
+int line_of(const YAML::Node& node, std::string_view key) {
+  if (!node.IsMap()) return 0;
+  const size_t dot = key.find('.');
+  const YAML::Node child = node[std::string(key.substr(0, dot))];  // const lookup: adds nothing
+  if (!child.IsDefined()) return 0;
+  if (dot == std::string_view::npos) return child.Mark().is_null() ? 0 : child.Mark().line + 1;
+  return line_of(child, key.substr(dot + 1));
+}
+
+// Rules between keys (each key's own range is in the schema).
+void check_relations(const DaemonConfig& cfg, const YAML::Node& root, const std::string& origin,
+                     std::vector<ConfigError>& errors) {
+  auto require = [&](bool ok, std::string_view key, const std::string& message) {
+    if (!ok) errors.push_back(ConfigError{origin, line_of(root, key), std::string(key), message});
+  };
+  require(cfg.tracker.quality_good_min >= cfg.tracker.quality_bad_below, "tracker.quality_good_min",
+          "must be >= tracker.quality_bad_below (" + std::to_string(cfg.tracker.quality_bad_below) +
+              "): the hysteresis needs it");
+  if (cfg.devices.tracker.rfind("hid:", 0) == 0 || cfg.devices.tracker.rfind("serial:", 0) == 0) {
+    std::string why;
+    require(amfitrack::parse_link_uri(cfg.devices.tracker, &why).has_value(), "devices.tracker",
+            why);
+  }
+  require(cfg.tracker.reconnect_max_ms >= cfg.tracker.reconnect_first_ms,
+          "tracker.reconnect_max_ms",
+          "must be >= tracker.reconnect_first_ms (" +
+              std::to_string(cfg.tracker.reconnect_first_ms) + ")");
+}
+
 }  // namespace
 
 std::string ConfigError::to_string() const {
@@ -202,6 +233,7 @@ ConfigResult load_config_text(const std::string& yaml, const std::string& origin
   YAML::Node root;
   if (!parse(yaml, origin, root, r.errors)) return r;
   if (!root.IsNull()) Loader(cfg, origin, r.errors, nullptr).walk(root, "");
+  if (r.errors.empty()) check_relations(cfg, root, origin, r.errors);
   if (r.errors.empty()) r.config = cfg;
   return r;
 }

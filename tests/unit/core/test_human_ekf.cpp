@@ -74,7 +74,7 @@ RunResult run(const std::vector<Truth>& truth, uint32_t seed, double outlier_rat
     if (u(rng) < outlier_rate) z.x_m += 1.5;  // a metal-distorted frame: 1.5 m off
     ekf.update_pose(z, true, t);
     if (t < settle) continue;
-    const auto& m = ekf.track().mean;
+    const auto& m = ekf.track().mean();
     se_pos += std::pow(m(0) - truth[i].pose.x_m, 2) + std::pow(m(1) - truth[i].pose.y_m, 2);
     se_head += std::pow(core::wrap_angle(m(2) - truth[i].pose.theta_rad), 2);
     se_vel += std::pow(m(3) - truth[i].vx, 2) + std::pow(m(4) - truth[i].vy, 2);
@@ -126,7 +126,7 @@ TEST(HumanEkf, VelocityConvergesWithinOneSecondOfAStop) {
     const Nanos t = kFrame * static_cast<int64_t>(i);
     ekf.update_pose({truth[i].pose.x_m + n(rng), truth[i].pose.y_m + n(rng), 0.0}, true, t);
     if (t >= 4s) {
-      se_after += std::pow(ekf.track().mean(3), 2) + std::pow(ekf.track().mean(4), 2);
+      se_after += std::pow(ekf.track().mean()(3), 2) + std::pow(ekf.track().mean()(4), 2);
       ++n_after;
     }
   }
@@ -155,7 +155,7 @@ TEST(HumanEkf, ARealJumpResetsTheTrackAfterTheConfiguredRejections) {
     EXPECT_EQ(ekf.update_pose({3, 0, 0}, true, t), core::UpdateResult::kRejected);
   }
   EXPECT_EQ(ekf.update_pose({3, 0, 0}, true, t), core::UpdateResult::kReset);
-  EXPECT_DOUBLE_EQ(ekf.track().mean(0), 3.0);
+  EXPECT_DOUBLE_EQ(ekf.track().mean()(0), 3.0);
   EXPECT_EQ(ekf.counters().resets, 2U);
   // After a long silence, the first pose restarts the track instead of being gated.
   t += 2s;
@@ -171,7 +171,7 @@ TEST(HumanEkf, InvalidInputChangesNothing) {
       << "time going backwards";
   EXPECT_EQ(ekf.update_yaw_rate(std::numeric_limits<double>::infinity(), 120ms),
             core::UpdateResult::kInvalid);
-  EXPECT_EQ(ekf.track().mean, before.mean);
+  EXPECT_EQ(ekf.track().mean_data, before.mean_data);
   EXPECT_EQ(ekf.counters().invalid_inputs, 3U);
 }
 
@@ -181,8 +181,8 @@ TEST(HumanEkf, WithoutHeadingOnlyThePositionIsUpdated) {
   for (int i = 1; i < 60; ++i) {
     ekf.update_pose({0.01 * i, 0, -2.0}, false, kFrame * i);  // the heading value is ignored
   }
-  EXPECT_NEAR(ekf.track().mean(2), 1.0, 0.05);
-  EXPECT_NEAR(ekf.track().mean(0), 0.59, 0.05);
+  EXPECT_NEAR(ekf.track().mean()(2), 1.0, 0.05);
+  EXPECT_NEAR(ekf.track().mean()(0), 0.59, 0.05);
 }
 
 TEST(HumanEkf, GyroYawRateSharpensTheTurnRate) {
@@ -203,8 +203,8 @@ TEST(HumanEkf, GyroYawRateSharpensTheTurnRate) {
     without.update_pose(z, true, t);
     with_gyro.update_yaw_rate(0.6 + ng(rng), t);
     if (t > 1s) {
-      se_with += std::pow(with_gyro.track().mean(5) - 0.6, 2);
-      se_without += std::pow(without.track().mean(5) - 0.6, 2);
+      se_with += std::pow(with_gyro.track().mean()(5) - 0.6, 2);
+      se_without += std::pow(without.track().mean()(5) - 0.6, 2);
     }
   }
   EXPECT_LT(se_with, 0.25 * se_without);
@@ -214,8 +214,8 @@ TEST(HumanEkf, GyroYawRateSharpensTheTurnRate) {
 TEST(HumanEkf, PredictsToQueryTimesAndIntoTheRobotFrame) {
   core::HumanTrack track;
   track.valid = true;
-  track.mean << 1.0, 2.0, 0.0, 1.0, 0.5, 0.1;
-  track.covariance = core::HumanCovariance::Identity() * 0.01;
+  track.mean() << 1.0, 2.0, 0.0, 1.0, 0.5, 0.1;
+  track.covariance() = core::HumanCovariance::Identity() * 0.01;
   track.stamp = 1s;
   track.last_update = 1s;
   std::array<Pose2, 3> path;

@@ -158,3 +158,24 @@ TEST(Config, AllErrorsOfAFileAreReportedAtOnce) {
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.errors.size(), 3U);
 }
+
+TEST(Config, RelationsBetweenKeysAreChecked) {
+  expect_error(load_config_text("tracker:\n  quality_bad_below: 150\n  quality_good_min: 120\n",
+                                "test.yaml"),
+               3, "tracker.quality_good_min", "must be >= tracker.quality_bad_below (150)");
+  // The offending key may come from the defaults: then there is no line.
+  const auto r = load_config_text("tracker:\n  reconnect_first_ms: 9000\n", "test.yaml");
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.errors[0].key, "tracker.reconnect_max_ms");
+  EXPECT_EQ(r.errors[0].line, 0);
+  EXPECT_TRUE(
+      load_config_text("tracker:\n  quality_bad_below: 120\n  quality_good_min: 120\n", "test.yaml")
+          .ok());
+}
+
+TEST(Config, TrackerDeviceUriIsChecked) {
+  expect_error(load_config_text("devices:\n  tracker: \"serial:/dev/ttyUSB0@fast\"\n", "test.yaml"),
+               2, "devices.tracker", "baud rate 'fast'");
+  EXPECT_TRUE(
+      load_config_text("devices:\n  tracker: \"serial:/dev/ttyUSB0@921600\"\n", "test.yaml").ok());
+}

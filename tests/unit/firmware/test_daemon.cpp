@@ -5,7 +5,10 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <functional>
+#include <map>
+#include <numbers>
 #include <thread>
 
 #include "firmware/config/config_loader.hpp"
@@ -13,6 +16,7 @@
 #include "firmware/task_table.hpp"
 #include "hal/can/virtual_can.hpp"
 #include "hal/sim_clock.hpp"
+#include "sim/sim_amfitrack.hpp"
 #include "sim/sim_scout_mini.hpp"
 #include "support/notify_socket.hpp"
 
@@ -233,16 +237,20 @@ TEST(Daemon, SameInputsSameOutputsBitForBit) {
 namespace {
 struct DaemonWithBase {
   // `script` runs in the world task at every 5 ms step, before the daemon's tasks.
-  explicit DaemonWithBase(std::function<void(Nanos, DaemonWithBase&)> script = {})
+  // With `with_tracker`, a simulated Amfitrack streams the person's sensor too.
+  explicit DaemonWithBase(std::function<void(Nanos, DaemonWithBase&)> script = {},
+                          bool with_tracker = false)
       : daemon(defaults(), notifier), base_bus("daemon-base", clock), base(base_bus) {
     auto host = std::make_unique<hal::VirtualCanBus>("daemon-base", clock);
     host_bus = host.get();
     EXPECT_TRUE(daemon.attach_base(std::move(host)));
+    if (with_tracker) daemon.attach_tracker(tracker.host_link());
     auto tasks = daemon.bindings();
     tasks.push_back(
         {core::TaskSpec{"world", 200, 100, 0, 255}, [this, script](const core::Tick& t) {
            if (script) script(t.now, *this);
            base.step(t.now);
+           tracker.step(t.now);
          }});
     executor = std::make_unique<firmware::Executor>(clock, firmware::group_table(), tasks);
     daemon.attach(*executor);
@@ -263,6 +271,7 @@ struct DaemonWithBase {
   hal::VirtualCanBus base_bus;
   hal::VirtualCanBus* host_bus = nullptr;  // the daemon's end (owned by the daemon)
   sim::SimScoutMini base;
+  sim::SimAmfitrack tracker;
   std::unique_ptr<firmware::Executor> executor;
 };
 
@@ -341,4 +350,101 @@ TEST(DaemonWithBase, FailedSendsAreWarnedAtMostOncePerInterval) {
   EXPECT_EQ(warnings, 3);
   EXPECT_TRUE(counted) << "later lines say how many were held back";
   EXPECT_TRUE(active(d.daemon.safety().read()->value, core::Reason::kCanBusOff));
+}
+
+// The tracker in the daemon: frames -> gate -> supervisor, and the person's state in odom.
+namespace {
+// The default config mounts the source turned by pi (its X to the robot's back), 0.35 m up:
+// a sensor at (-1.2, 0.3) in the source frame is 1.2 m ahead and 0.3 m to the right.
+void person_ahead(sim::SimAmfitrack& t) {
+  t.set_sensor_pose(-1.2, 0.3, 0.0, std::numbers::pi);
+}
+
+bool tracker_ok(const firmware::SafetySnapshot& s) {
+  return !active(s, core::Reason::kTrackerSilent) &&
+         !active(s, core::Reason::kTrackerConfidenceLow) && !active(s, core::Reason::kPersonLost);
+}
+}  // namespace
+
+TEST(DaemonWithTracker, ConfidenceDropHoldsWithinAFrameAndRecoversAfterTheHysteresis) {
+  auto ring = std::make_shared<spdlog::sinks::ringbuffer_sink_mt>(10000);
+  auto previous = spdlog::default_logger();
+  spdlog::set_default_logger(std::make_shared<spdlog::logger>("capture", ring));
+  std::map<Nanos, firmware::SafetySnapshot> seen;
+  DaemonWithBase d(
+      [&](Nanos now, DaemonWithBase& w) {
+        if (now == 0ms) person_ahead(w.tracker);
+        if (now == 3s) w.tracker.set_quality(60);  // metal near the sensor: quality collapses
+        if (now == 4s) w.tracker.set_quality(230);
+        for (Nanos at : {2900ms, 3020ms, 4500ms, 5000ms, 5400ms}) {
+          if (now == at) seen[at] = w.daemon.safety().read()->value;
+        }
+      },
+      true);
+  d.run_until(5500ms);
+  spdlog::set_default_logger(previous);
+
+  EXPECT_TRUE(tracker_ok(seen[2900ms])) << "good frames at 120 Hz: nothing to say";
+  EXPECT_TRUE(active(seen[3020ms], core::Reason::kTrackerConfidenceLow))
+      << "BAD within a frame, judged by the next supervisor run";
+  EXPECT_TRUE(active(seen[4500ms], core::Reason::kTrackerConfidenceLow))
+      << "GOOD again at 4.1 s, but the supervisor waits tracker_confidence_recover_ms";
+  EXPECT_TRUE(active(seen[5000ms], core::Reason::kTrackerConfidenceLow));
+  EXPECT_TRUE(tracker_ok(seen[5400ms]));
+
+  bool logged = false;
+  for (const auto& line : ring->last_formatted()) {
+    logged = logged ||
+             (line.find("tracker confidence BAD (quality low), quality 60") != std::string::npos);
+  }
+  EXPECT_TRUE(logged) << "the transition names the gate's reason and the value";
+
+  const auto h = d.daemon.tracker_health().read();
+  ASSERT_TRUE(h);
+  EXPECT_NEAR(h->value.rate_hz, 120.0, 2.0);
+  EXPECT_EQ(h->value.dropped_frames, 0U);
+  EXPECT_TRUE(h->value.link_up);
+}
+
+TEST(DaemonWithTracker, EstimatesThePersonInOdom) {
+  DaemonWithBase d(
+      [](Nanos now, DaemonWithBase& w) {
+        if (now == 0ms) person_ahead(w.tracker);
+      },
+      true);
+  d.run_until(2s);
+  const auto t = d.daemon.human_track().read();
+  ASSERT_TRUE(t);
+  ASSERT_TRUE(t->value.valid);
+  // The base stands at the odom origin: odom = base_link here.
+  const auto h = core::human_state(t->value, 2s, core::Pose2{}, d.daemon.human_config());
+  EXPECT_NEAR(h.pose_odom.x_m, 1.2, 1e-3);
+  EXPECT_NEAR(h.pose_odom.y_m, -0.3, 1e-3);
+  EXPECT_NEAR(h.pose_odom.theta_rad, 0.0, 1e-3) << "sensor facing the source's -X: forward";
+  EXPECT_NEAR(std::hypot(h.velocity_odom.x_m, h.velocity_odom.y_m), 0.0, 1e-3);
+  EXPECT_LT(h.age, 20ms);
+  const auto th = d.daemon.tracker_health().read()->value;
+  EXPECT_NEAR(th.person_distance_m, std::hypot(1.2, 0.3), 1e-3);
+  EXPECT_EQ(th.filter_rejected, 0U);
+}
+
+TEST(DaemonWithTracker, SilenceAndDistanceReachTheSupervisor) {
+  std::map<Nanos, firmware::SafetySnapshot> seen;
+  DaemonWithBase d(
+      [&](Nanos now, DaemonWithBase& w) {
+        if (now == 0ms) person_ahead(w.tracker);
+        if (now == 2s) w.tracker.set_silent(true);
+        if (now == 2500ms) {
+          w.tracker.set_silent(false);
+          w.tracker.set_sensor_pose(-3.5, 0.0, 0.0, std::numbers::pi);  // 3.5 m away
+        }
+        for (Nanos at : {1900ms, 2200ms, 2700ms}) {
+          if (now == at) seen[at] = w.daemon.safety().read()->value;
+        }
+      },
+      true);
+  d.run_until(2800ms);
+  EXPECT_TRUE(tracker_ok(seen[1900ms]));
+  EXPECT_TRUE(active(seen[2200ms], core::Reason::kTrackerSilent));
+  EXPECT_TRUE(active(seen[2700ms], core::Reason::kPersonLost));
 }

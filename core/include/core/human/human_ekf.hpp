@@ -6,6 +6,7 @@
 // are rejected by a Mahalanobis gate; a run of rejections (the person really is elsewhere, e.g.
 // after a tracking gap) re-initialises the track. Pure: time is an argument; no allocation.
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -33,14 +34,25 @@ struct HumanEkfConfig {
 using HumanVector = Eigen::Matrix<double, 6, 1>;
 using HumanCovariance = Eigen::Matrix<double, 6, 6>;
 
-// The filter's state at `stamp`: a plain value, published to other tasks, which predict it to
-// their own query time with predict_track().
+// The filter's state at `stamp`: a plain, trivially copyable value (it travels through
+// latest-value channels); other tasks predict it to their own query time with predict_track().
 struct HumanTrack {
   bool valid = false;
-  HumanVector mean = HumanVector::Zero();
-  HumanCovariance covariance = HumanCovariance::Identity();
-  Nanos stamp{0};        // time of `mean`
-  Nanos last_update{0};  // time of the latest accepted pose
+  std::array<double, 6> mean_data{};         // [x, y, theta, vx, vy, omega]
+  std::array<double, 36> covariance_data{};  // 6 x 6, column-major
+  Nanos stamp{0};                            // time of the mean
+  Nanos last_update{0};                      // time of the latest accepted pose
+
+  Eigen::Map<HumanVector> mean() { return Eigen::Map<HumanVector>(mean_data.data()); }
+  [[nodiscard]] Eigen::Map<const HumanVector> mean() const {
+    return Eigen::Map<const HumanVector>(mean_data.data());
+  }
+  Eigen::Map<HumanCovariance> covariance() {
+    return Eigen::Map<HumanCovariance>(covariance_data.data());
+  }
+  [[nodiscard]] Eigen::Map<const HumanCovariance> covariance() const {
+    return Eigen::Map<const HumanCovariance>(covariance_data.data());
+  }
 };
 
 struct HumanEkfCounters {

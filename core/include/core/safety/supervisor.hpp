@@ -25,6 +25,8 @@ struct SafetyInputs {
 
   Nanos tracker_stamp = kNever;  // latest tracker frame that decoded
   TrackerConfidence tracker_confidence = TrackerConfidence::kUnknown;
+  const char* tracker_detail = "";  // why (the gate's reason; static text), for the log line
+  int tracker_quality = -1;         // effective quality 0..255 (-1: unknown)
   double person_distance_m = std::numeric_limits<double>::quiet_NaN();
 
   Nanos lidar_stamp = kNever;    // latest lidar packet decoded

@@ -25,6 +25,7 @@ struct AmfitrackConfig {
 struct StampedMeasurement {
   SensorMeasurement m;
   hal::Nanos stamp;
+  Confidence confidence = Confidence::kBad;  // the gate's verdict right after this frame
 };
 
 // A device that answered RequestDeviceID (and, later, the name / firmware requests).
@@ -60,7 +61,10 @@ class Amfitrack {
   [[nodiscard]] const std::vector<StampedMeasurement>& new_measurements() const { return fresh_; }
   [[nodiscard]] const std::optional<StampedMeasurement>& latest() const { return latest_; }
   [[nodiscard]] GateOutput confidence(hal::Nanos now) const { return gate_.evaluate(now); }
+  // Frames per second of the sensor (frame-id steps, so drops do not read as a slow rate),
+  // measured over windows of at least kRateWindow of polls; 0 until the first window closes.
   [[nodiscard]] double rate_hz() const { return rate_hz_; }
+  static constexpr hal::Nanos kRateWindow = std::chrono::milliseconds(500);
   [[nodiscard]] const AmfitrackCounters& counters() const { return counters_; }
   [[nodiscard]] const std::map<uint8_t, DeviceInfo>& devices() const { return devices_; }
   [[nodiscard]] bool link_failed() const { return link_.failed(); }
@@ -79,6 +83,9 @@ class Amfitrack {
   std::optional<StampedMeasurement> latest_;
   std::map<uint8_t, DeviceInfo> devices_;
   double rate_hz_ = 0;
+  bool rate_window_open_ = false;
+  uint32_t rate_window_ids_ = 0;  // frame-id steps since the window opened
+  hal::Nanos rate_window_start_{0};
   bool keepalive_sent_ = false;
   hal::Nanos last_keepalive_{0};
   uint8_t packet_number_ = 0;

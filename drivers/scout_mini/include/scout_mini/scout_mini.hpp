@@ -103,6 +103,8 @@ class ScoutMini {
   // Time of the latest motion feedback (0x221) or system state (0x211); 0 if none yet.
   [[nodiscard]] hal::Nanos last_feedback() const { return last_feedback_; }
   [[nodiscard]] bool feedback_silent(hal::Nanos now) const;
+  // Time of state().odom (the latest integrated 0x221); 0 if none yet.
+  [[nodiscard]] hal::Nanos odom_stamp() const { return odometry_.stamp(); }
   [[nodiscard]] bool bus_off() const { return bus_.state() == hal::CanBusState::kBusOff; }
   [[nodiscard]] hal::CanBusState bus_state() const { return bus_.state(); }
 

@@ -14,6 +14,34 @@ struct DaemonConfig {
     std::string base;   // socketcan:<ifname> | slcan:<tty> | virtual:<bus> | sim | none
   } devices;
 
+  struct Tracker {
+    int64_t sensor_tx_id = 0;
+    int64_t keepalive_period_ms = 0;
+    int64_t reconnect_first_ms = 0;
+    int64_t reconnect_max_ms = 0;
+    bool quality_high_is_good = true;
+    int64_t quality_bad_below = 0;
+    int64_t quality_good_min = 0;
+    double quaternion_norm_tolerance = 0;
+    int64_t max_age_ms = 0;
+    int64_t recover_frames = 0;
+    double source_x_m = 0, source_y_m = 0, source_z_m = 0;
+    double source_roll_rad = 0, source_pitch_rad = 0, source_yaw_rad = 0;
+    double sensor_in_body_roll_rad = 0, sensor_in_body_pitch_rad = 0, sensor_in_body_yaw_rad = 0;
+  } tracker;
+
+  struct Human {
+    double position_noise_m = 0;
+    double heading_noise_rad = 0;
+    bool use_gyro = false;
+    double yaw_rate_noise_radps = 0;
+    double accel_noise_mps2 = 0;
+    double yaw_accel_noise_radps2 = 0;
+    double gate_probability = 0;
+    int64_t reset_after_rejects = 0;
+    int64_t reset_after_gap_ms = 0;
+  } human;
+
   struct Realtime {
     bool enable = true;    // try mlockall + SCHED_FIFO threads
     bool require = false;  // refuse to start if not permitted
