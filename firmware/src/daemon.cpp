@@ -423,6 +423,7 @@ void Daemon::report_task(const core::Tick& tick) {
       }
     }
   }
+  if (tracker_) line += " | " + tracker_text(tick.now);
   line += " | " + rates;
   if (!shells.empty()) line += " | not yet implemented: " + shells;
   status_ = line;
@@ -438,6 +439,24 @@ void Daemon::report_task(const core::Tick& tick) {
     spdlog::info("timing: {}", timing_summary());
     last_summary_ = tick.now;
   }
+}
+
+std::string Daemon::tracker_text(Nanos now) const {
+  const auto t = tracker_health_.read();
+  if (!t) return "tracker -";
+  const TrackerHealth& h = t->value;
+  if (!h.link_up) return "tracker link down";
+  if (h.frame_stamp == core::kNever) return "tracker no frames";
+  std::string s = fmt::format("tracker {}", core::confidence_name(h.confidence));
+  if (h.gate_reason != amfitrack::GateReason::kNone) {
+    s += fmt::format(" ({})", amfitrack::to_string(h.gate_reason));
+  }
+  s += fmt::format(" q{} {:.0f}Hz age {:.0f}ms", h.quality, h.rate_hz,
+                   core::to_ms(now - h.frame_stamp));
+  if (!std::isnan(h.person_distance_m)) s += fmt::format(" person {:.2f}m", h.person_distance_m);
+  if (h.dropped_frames > 0) s += fmt::format(" drops {}", h.dropped_frames);
+  if (h.decode_errors > 0) s += fmt::format(" errors {}", h.decode_errors);
+  return s;
 }
 
 std::string Daemon::status_line() const {

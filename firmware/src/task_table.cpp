@@ -25,7 +25,7 @@ const std::array<core::GroupSpec, 4>& group_table() {
 
 const std::array<TaskRow, 8>& task_table() {
   static const std::array<TaskRow, 8> kTable{{
-      COMPANION_TASK(tracker, 120, 300, kGroupRealtime, 90, "Amfitrack driver (issue 5)"),
+      COMPANION_TASK(tracker, 120, 300, kGroupRealtime, 90, ""),
       COMPANION_TASK(base, 50, 200, kGroupRealtime, 80, ""),
       COMPANION_TASK(supervisor, 100, 50, kGroupRealtime, 70, ""),
       COMPANION_TASK(control, 100, 3000, kGroupRealtime, 60, "MPPI-CBF controller (issue 6)"),

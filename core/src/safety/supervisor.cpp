@@ -14,19 +14,6 @@ double age_ms(Nanos stamp, Nanos now) {
   return stamp == kNever ? std::numeric_limits<double>::infinity() : to_ms(now - stamp);
 }
 
-const char* confidence_name(TrackerConfidence c) {
-  switch (c) {
-    case TrackerConfidence::kGood:
-      return "GOOD";
-    case TrackerConfidence::kDegraded:
-      return "DEGRADED";
-    case TrackerConfidence::kBad:
-      return "BAD";
-    case TrackerConfidence::kUnknown:
-      break;
-  }
-  return "UNKNOWN";
-}
 
 }  // namespace
 
@@ -91,6 +78,20 @@ ReasonSet Supervisor::evaluate(const SafetyInputs& in, Nanos now) {
   for (size_t i = 0; i < kReasonCount; ++i)
     active[i] = debounce_[i].update(raw[i], now);
   return active;
+}
+
+const char* confidence_name(TrackerConfidence c) {
+  switch (c) {
+    case TrackerConfidence::kGood:
+      return "GOOD";
+    case TrackerConfidence::kDegraded:
+      return "DEGRADED";
+    case TrackerConfidence::kBad:
+      return "BAD";
+    case TrackerConfidence::kUnknown:
+      break;
+  }
+  return "UNKNOWN";
 }
 
 Reason Supervisor::primary(const ReasonSet& set, Severity min_severity) {

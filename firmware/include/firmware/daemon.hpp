@@ -126,6 +126,7 @@ class Daemon {
 
  private:
   std::string safety_text(const SafetySnapshot& s) const;
+  std::string tracker_text(core::Nanos now) const;
 
   DaemonConfig cfg_;
   hal::SystemdNotifier& notifier_;

@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "hal/can/hex.hpp"
+#include "hal/capture/log_line.hpp"
 
 namespace hal {
 namespace {
@@ -19,16 +20,6 @@ bool parse_hex(std::string_view s, uint64_t& out) {
   return true;
 }
 
-bool parse_dec(std::string_view s, int64_t& out) {
-  if (s.empty() || s.size() > 18) return false;
-  out = 0;
-  for (const char c : s) {
-    if (c < '0' || c > '9') return false;
-    out = out * 10 + (c - '0');
-  }
-  return true;
-}
-
 CandumpParse fail(std::string& error, const char* why) {
   error = why;
   return CandumpParse::kMalformed;
@@ -37,35 +28,19 @@ CandumpParse fail(std::string& error, const char* why) {
 }  // namespace
 
 CandumpParse parse_candump_line(std::string_view line, CandumpRecord& out, std::string& error) {
-  while (!line.empty() && (line.back() == '\n' || line.back() == '\r'))
-    line.remove_suffix(1);
-  if (line.empty() || line.front() != '(') return CandumpParse::kIgnored;
-
-  const size_t close = line.find(')');
-  if (close == std::string_view::npos) return fail(error, "no ')' after the timestamp");
-  const std::string_view stamp = line.substr(1, close - 1);
-  const size_t dot = stamp.find('.');
-  if (dot == std::string_view::npos) return fail(error, "timestamp without fraction");
-  const std::string_view frac = stamp.substr(dot + 1);
-  if (frac.size() != 6 && frac.size() != 9) return fail(error, "timestamp needs 6 or 9 digits");
-  int64_t sec = 0;
-  int64_t f = 0;
-  if (!parse_dec(stamp.substr(0, dot), sec) || !parse_dec(frac, f)) {
-    return fail(error, "bad timestamp digits");
+  LogLine ll;
+  switch (split_log_line(line, ll, error)) {
+    case LogLineParse::kIgnored:
+      return CandumpParse::kIgnored;
+    case LogLineParse::kMalformed:
+      return CandumpParse::kMalformed;
+    case LogLineParse::kRecord:
+      break;
   }
-  out.sec = sec;
-  out.nsec = frac.size() == 6 ? f * 1000 : f;
-
-  std::string_view rest = line.substr(close + 1);
-  if (rest.empty() || rest.front() != ' ') return fail(error, "no space after the timestamp");
-  rest.remove_prefix(1);
-  const size_t sp = rest.find(' ');
-  if (sp == std::string_view::npos || sp == 0) return fail(error, "no interface name");
-  out.iface = std::string(rest.substr(0, sp));
-  std::string_view frame = rest.substr(sp + 1);
-  // Trailing annotations (e.g. " T" / " R" direction flags of newer candump) are ignored.
-  if (const size_t end = frame.find(' '); end != std::string_view::npos)
-    frame = frame.substr(0, end);
+  out.sec = ll.sec;
+  out.nsec = ll.nsec;
+  out.iface = std::string(ll.iface);
+  const std::string_view frame = ll.payload;
 
   const size_t hash = frame.find('#');
   if (hash == std::string_view::npos) return fail(error, "no '#' in the frame");
@@ -118,15 +93,7 @@ CandumpParse parse_candump_line(std::string_view line, CandumpRecord& out, std::
 }
 
 std::string format_candump_line(const CandumpRecord& rec, bool nine_digits) {
-  char stamp[48];
-  if (nine_digits) {
-    (void)std::snprintf(stamp, sizeof(stamp), "(%lld.%09lld) ", static_cast<long long>(rec.sec),
-                        static_cast<long long>(rec.nsec));
-  } else {
-    (void)std::snprintf(stamp, sizeof(stamp), "(%lld.%06lld) ", static_cast<long long>(rec.sec),
-                        static_cast<long long>(rec.nsec / 1000));
-  }
-  return std::string(stamp) + rec.iface + " " + to_cansend(rec.frame);
+  return log_line_prefix(rec.sec, rec.nsec, rec.iface, nine_digits) + to_cansend(rec.frame);
 }
 
 CandumpReader::CandumpReader(const std::string& path) : in_(path) {}

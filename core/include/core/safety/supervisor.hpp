@@ -17,6 +17,7 @@ namespace core {
 inline constexpr Nanos kNever = Nanos(std::numeric_limits<int64_t>::min());
 
 enum class TrackerConfidence : uint8_t { kUnknown = 0, kGood = 1, kDegraded = 2, kBad = 3 };
+const char* confidence_name(TrackerConfidence c);  // "GOOD", "DEGRADED", "BAD", "UNKNOWN"
 
 // A snapshot of everything the supervisor judges, gathered by the supervisor task from the
 // channels. Stamps are monotonic times of the latest data (kNever: nothing received yet).
