@@ -17,6 +17,7 @@
 #include <mutex>
 #include <thread>
 
+#include "firmware/tool_console.hpp"
 #include "hal/can/can_bus.hpp"
 #include "hal/can/candump_log.hpp"
 #include "hal/linux_clock.hpp"
@@ -29,24 +30,8 @@ namespace sm = scout_mini;
 using hal::Nanos;
 using namespace std::chrono_literals;
 
-std::atomic<bool> g_interrupted{false};
-
-// Console output of the tool (stdout for results, stderr for errors); printf-checked formats.
-__attribute__((format(printf, 1, 2))) void say(const char* format, ...) {
-  va_list args;
-  va_start(args, format);
-  (void)std::vprintf(format, args);
-  va_end(args);
-}
-__attribute__((format(printf, 1, 2))) void complain(const char* format, ...) {
-  va_list args;
-  va_start(args, format);
-  (void)std::vfprintf(stderr, format, args);
-  va_end(args);
-}
-void on_signal(int /*sig*/) {
-  g_interrupted.store(true);
-}
+using firmware::tool::complain;
+using firmware::tool::say;
 
 // Exit codes: 0 ok, 1 check failed / jog aborted, 2 cannot talk to the base (no bus, no frames,
 // wrong protocol), 3 usage.
@@ -217,7 +202,7 @@ std::string text_state(const sm::ScoutMini& d, Nanos now) {
 void listen(sm::ScoutMini& d, hal::Clock& clock, Nanos duration) {
   hal::LinuxClock sleeper;
   const Nanos end = clock.now() + duration;
-  while (clock.now() < end && !g_interrupted) {
+  while (clock.now() < end && !firmware::tool::interrupted()) {
     d.poll(clock.now());
     sleeper.sleep_until(clock.now() + 5ms);
   }
@@ -308,8 +293,7 @@ int run(int argc, char** argv) {
   jog->add_option("--duration-s", jog_s, "seconds (max 10)")->check(CLI::Range(0.0, 10.0));
   CLI11_PARSE(app, argc, argv);
 
-  (void)std::signal(SIGINT, on_signal);
-  (void)std::signal(SIGTERM, on_signal);
+  firmware::tool::catch_interrupts();
   hal::LinuxClock clock;
 
   std::unique_ptr<SimBase> simbase;
@@ -346,7 +330,7 @@ int run(int argc, char** argv) {
     const Nanos end = monitor_s > 0 ? clock.now() + std::chrono::duration_cast<Nanos>(
                                                         std::chrono::duration<double>(monitor_s))
                                     : Nanos::max();
-    while (!g_interrupted && clock.now() < end) {
+    while (!firmware::tool::interrupted() && clock.now() < end) {
       listen(driver, clock, 200ms);
       if (json) {
         say("%s\n", json_state(driver, clock.now()).c_str());
@@ -405,7 +389,7 @@ int run(int argc, char** argv) {
             ? clock.now() + std::chrono::duration_cast<Nanos>(std::chrono::duration<double>(dump_s))
             : Nanos::max();
     hal::LinuxClock sleeper;
-    while (!g_interrupted && clock.now() < end) {
+    while (!firmware::tool::interrupted() && clock.now() < end) {
       while (auto rx = bus.receive()) {
         if (dump_candump) {
           timespec rt{};
@@ -439,7 +423,7 @@ int run(int argc, char** argv) {
     uint64_t failed = 0;
     int64_t last_ns = 0;
     while (auto rec = reader.next()) {
-      if (g_interrupted) break;
+      if (firmware::tool::interrupted()) break;
       const int64_t t = rec->sec * 1'000'000'000 + rec->nsec;
       if (first_ns < 0) first_ns = t;
       last_ns = t;
@@ -524,7 +508,7 @@ int run(int argc, char** argv) {
       const Nanos now = clock.now();
       driver.poll(now);
       const auto& s = driver.state();
-      if (g_interrupted) {
+      if (firmware::tool::interrupted()) {
         why = "interrupted";
       } else if (s.estop()) {
         why = "E-stop";

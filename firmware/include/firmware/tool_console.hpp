@@ -1,0 +1,36 @@
+#pragma once
+// Console output of the small command-line tools (stdout for results, stderr for errors), with
+// printf-checked formats, and Ctrl-C as a flag the tools' loops poll.
+#include <atomic>
+#include <csignal>
+#include <cstdarg>
+#include <cstdio>
+
+namespace firmware::tool {
+
+__attribute__((format(printf, 1, 2))) inline void say(const char* format, ...) {
+  va_list args;
+  va_start(args, format);
+  (void)std::vprintf(format, args);
+  va_end(args);
+}
+__attribute__((format(printf, 1, 2))) inline void complain(const char* format, ...) {
+  va_list args;
+  va_start(args, format);
+  (void)std::vfprintf(stderr, format, args);
+  va_end(args);
+}
+
+inline std::atomic<bool>& interrupted() {
+  static std::atomic<bool> flag{false};
+  return flag;
+}
+inline void on_signal(int /*sig*/) {
+  interrupted().store(true);
+}
+inline void catch_interrupts() {
+  (void)std::signal(SIGINT, on_signal);
+  (void)std::signal(SIGTERM, on_signal);
+}
+
+}  // namespace firmware::tool
