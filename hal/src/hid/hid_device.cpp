@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <cwchar>
+#include <filesystem>
 #include <mutex>
 
 namespace hal {
@@ -112,9 +113,25 @@ const HidDeviceInfo* select_hid(const std::vector<HidDeviceInfo>& devices,
   return nullptr;
 }
 
+std::string resolve_device_path(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::path p(path);
+  for (int hops = 0; hops < 8 && fs::is_symlink(p, ec); ++hops) {
+    const fs::path target = fs::read_symlink(p, ec);
+    if (ec) break;
+    p = target.is_absolute() ? target : (p.parent_path() / target).lexically_normal();
+  }
+  return p.string();
+}
+
 HidOpenResult open_hid(uint16_t vendor_id, std::span<const uint16_t> product_ids,
-                       const HidSelector& selector) {
+                       const HidSelector& requested) {
   HidOpenResult r;
+  HidSelector selector = requested;
+  if (selector.kind == HidSelector::Kind::kPath) {
+    selector.value = resolve_device_path(selector.value);
+  }
   std::string error;
   const auto devices = hid_enumerate(vendor_id, product_ids, &error);
   if (!error.empty()) {

@@ -2,6 +2,8 @@
 // Amfitrack plugged in: the error must say what was looked for).
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include "hal/hid/hid_device.hpp"
 
 namespace {
@@ -58,4 +60,20 @@ TEST(HidOpen, MissingDeviceIsAClearError) {
   EXPECT_NE(r.error.find("0xfffe"), std::string::npos) << r.error;
 }
 
+}  // namespace
+
+namespace {
+TEST(HidSelector, UdevSymlinksResolveToTheHidrawNode) {
+  const std::string dir = ::testing::TempDir() + "hid_links";
+  std::filesystem::create_directories(dir);
+  const std::string link = dir + "/amfitrack-sensor";
+  std::filesystem::remove(link);
+  std::filesystem::create_symlink("/dev/hidraw4", link);
+  EXPECT_EQ(hal::resolve_device_path(link), "/dev/hidraw4");
+  const std::string relative = dir + "/rel";
+  std::filesystem::remove(relative);
+  std::filesystem::create_symlink("amfitrack-sensor", relative);  // a link to the link
+  EXPECT_EQ(hal::resolve_device_path(relative), "/dev/hidraw4");
+  EXPECT_EQ(hal::resolve_device_path("/dev/hidraw7"), "/dev/hidraw7");
+}
 }  // namespace

@@ -44,6 +44,9 @@ struct HidSelector {
   std::string value;
 };
 HidSelector parse_hid_selector(const std::string& text);
+// A device path with its symbolic links followed (udev's /dev/amfitrack-sensor -> hidraw3), so it
+// compares with the enumerated hidraw paths. Unchanged when it is not a link.
+std::string resolve_device_path(const std::string& path);
 // Picks from an enumeration; nullptr when nothing matches. A path is accepted only if it is one
 // of the listed devices (so a wrong hidraw node is not opened by mistake).
 const HidDeviceInfo* select_hid(const std::vector<HidDeviceInfo>& devices,
