@@ -255,21 +255,22 @@ int cmd_stream(Live& live, uint8_t sensor, bool json, double duration_s, uint64_
   const auto& c = tracker.counters();
   const am::FramingStats fs = live.link->framing_stats();
   uint64_t payload_errors = 0;
-  for (uint64_t e : c.payload_errors)
+  for (uint64_t e : c.payload_errors) {
     payload_errors += e;
+  }
+  const uint64_t framing_errors = fs.bad_cobs + fs.overlong + fs.bad_packet;
   const std::string summary = fmt::format(
       "frames {} rate {:.1f} Hz dropped {} repeated {} other_tx {} framing_errors {} "
       "payload_errors {}{}",
       c.poses, tracker.rate_hz(), c.dropped_frames, c.repeated_frames, c.poses_other_sensor,
-      fs.bad_cobs + fs.overlong + fs.bad_packet, payload_errors,
-      tracker.link_failed() ? " LINK FAILED" : "");
+      framing_errors, payload_errors, tracker.link_failed() ? " LINK FAILED" : "");
   if (json) {
     say("{\"summary\":{\"frames\":%llu,\"rate_hz\":%.2f,\"dropped\":%llu,\"repeated\":%llu,"
         "\"framing_errors\":%llu,\"payload_errors\":%llu,\"link_failed\":%s}}\n",
         static_cast<unsigned long long>(c.poses), tracker.rate_hz(),
         static_cast<unsigned long long>(c.dropped_frames),
         static_cast<unsigned long long>(c.repeated_frames),
-        static_cast<unsigned long long>(fs.bad_cobs + fs.overlong + fs.bad_packet),
+        static_cast<unsigned long long>(framing_errors),
         static_cast<unsigned long long>(payload_errors), tracker.link_failed() ? "true" : "false");
   } else {
     say("%s\n", summary.c_str());
@@ -410,9 +411,7 @@ int cmd_info(Live& live, double timeout_s) {
   return complete() ? 0 : kExitFail;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   CLI::App app{"companion-tracker: Amfitrack Gen 3 tool (list, stream, record, decode, info)"};
   app.require_subcommand(1);
   std::string device = "hid:auto";
@@ -464,4 +463,15 @@ int main(int argc, char** argv) {
   if (app.got_subcommand("record")) return cmd_record(*live, file, duration_s);
   if (app.got_subcommand("info")) return cmd_info(*live, timeout_s);
   return 3;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    complain("companion-tracker: %s\n", e.what());
+    return 3;
+  }
 }

@@ -13,18 +13,14 @@ Eigen::Matrix3d rpy(const std::array<double, 3>& a) {
       .toRotationMatrix();
 }
 
+using RowMajor3d = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+
 void store(const Eigen::Matrix3d& m, std::array<double, 9>& out) {
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c)
-      out[static_cast<size_t>(3 * r + c)] = m(r, c);
+  Eigen::Map<RowMajor3d>(out.data()) = m;
 }
 
 Eigen::Matrix3d load(const std::array<double, 9>& a) {
-  Eigen::Matrix3d m;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c)
-      m(r, c) = a[static_cast<size_t>(3 * r + c)];
-  return m;
+  return Eigen::Map<const RowMajor3d>(a.data());
 }
 
 // Below this length of the floor projection of the body x axis (i.e. within ~8 degrees of

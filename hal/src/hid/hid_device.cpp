@@ -9,6 +9,7 @@
 #include <cwchar>
 #include <filesystem>
 #include <mutex>
+#include <system_error>
 
 namespace hal {
 namespace {
@@ -152,7 +153,8 @@ HidOpenResult open_hid(uint16_t vendor_id, std::span<const uint16_t> product_ids
   }
   hid_device* dev = hid_open_path(pick->path.c_str());
   if (dev == nullptr) {
-    r.error = "hid: cannot open " + pick->path + ": " + std::strerror(errno) +
+    r.error = "hid: cannot open " + pick->path + ": " +
+              std::error_code(errno, std::generic_category()).message() +
               " (permissions: the udev rule grants the companion group access)";
     return r;
   }
