@@ -12,6 +12,8 @@
 #include <ctime>
 #include <system_error>
 
+#include "hal/kernel_stamp.hpp"
+
 namespace hal::socketcan {
 
 can_frame to_linux(const CanFrame& f) {
@@ -188,14 +190,9 @@ std::optional<StampedCanFrame> SocketCanBus::receive() {
     if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SO_TIMESTAMP) {
       timeval tv{};
       std::memcpy(&tv, CMSG_DATA(c), sizeof(tv));
-      // Kernel stamps are CLOCK_REALTIME: shift into the monotonic domain.
-      timespec rt{};
-      clock_gettime(CLOCK_REALTIME, &rt);
-      const Nanos real_now(static_cast<int64_t>(rt.tv_sec) * 1'000'000'000 + rt.tv_nsec);
       const Nanos kernel(static_cast<int64_t>(tv.tv_sec) * 1'000'000'000 +
                          static_cast<int64_t>(tv.tv_usec) * 1000);
-      const Nanos age = real_now - kernel;
-      if (age >= Nanos(0) && age < std::chrono::seconds(1)) stamp -= age;
+      stamp = monotonic_from_kernel_stamp(kernel, stamp);
     }
   }
   const CanFrame f = socketcan::from_linux(cf);

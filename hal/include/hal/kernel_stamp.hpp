@@ -1,0 +1,12 @@
+#pragma once
+// Kernel receive timestamps (SO_TIMESTAMP / SO_TIMESTAMPNS) are CLOCK_REALTIME; the daemon's
+// time is CLOCK_MONOTONIC. Shifts a kernel stamp by its age, measured on the realtime clock now.
+#include "hal/clock.hpp"
+
+namespace hal {
+
+// `received_now` is the monotonic time of the read; the result is earlier by the datagram's age
+// in the socket queue. Ages outside [0, 1 s) (the wall clock jumped) are ignored.
+Nanos monotonic_from_kernel_stamp(Nanos kernel_realtime, Nanos received_now);
+
+}  // namespace hal
