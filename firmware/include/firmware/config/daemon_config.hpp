@@ -30,6 +30,15 @@ struct DaemonConfig {
     double sensor_in_body_roll_rad = 0, sensor_in_body_pitch_rad = 0, sensor_in_body_yaw_rad = 0;
   } tracker;
 
+  struct Lidar {
+    double x_m = 0, y_m = 0, z_m = 0;
+    double roll_rad = 0, pitch_rad = 0, yaw_rad = 0;
+    double cut_azimuth_deg = 0;
+    double min_range_m = 0;
+    double max_range_m = 0;
+    int64_t receive_buffer_bytes = 0;
+  } lidar;
+
   struct Human {
     double position_noise_m = 0;
     double heading_noise_rad = 0;
