@@ -1,0 +1,63 @@
+#pragma once
+// The 2-D costmap the planner and the controller read, projected from the voxel grid and
+// inflated with an exact Euclidean distance transform. Scale 0..100 (the paper's R = 30 on it):
+//   100  obstacle, or closer than the robot's inscribed radius to one (a collision);
+//   99..1  99 * exp(-k (d - r_inscribed)) for an obstacle at distance d (Nav2's shape, rescaled);
+//   0    free, or farther than the inflation radius from every obstacle.
+// With r_inscribed = 0.35 m and k = 3 /m, cost >= 30 (R, "unsafe") means d < 0.75 m.
+// A Costmap is a plain value: built by the lidar task, then published as an immutable snapshot.
+#include <cstdint>
+#include <vector>
+
+#include "core/perception/voxel_grid.hpp"
+
+namespace core {
+
+struct CostmapConfig {
+  double inscribed_radius_m = 0.35;
+  double inflation_radius_m = 1.2;
+  double cost_scaling_per_m = 3.0;  // k
+};
+
+inline constexpr uint8_t kCostLethal = 100;
+
+class Costmap {
+ public:
+  Costmap() = default;
+  Costmap(int cells, double resolution_m);
+
+  // Obstacles = columns of the grid with any occupied voxel in the band; then inflation.
+  // Reuses this costmap's buffers (no allocation when the size does not change).
+  void build(const VoxelGrid& grid, const CostmapConfig& config, Nanos stamp);
+
+  [[nodiscard]] int cells() const { return n_; }
+  [[nodiscard]] double resolution() const { return res_; }
+  [[nodiscard]] double origin_x() const { return ox_; }  // odom, lower corner
+  [[nodiscard]] double origin_y() const { return oy_; }
+  [[nodiscard]] Nanos stamp() const { return stamp_; }
+  // Cell (i, j): x = origin_x + (i + 0.5) res. Outside the map: lethal (unknown is not free).
+  [[nodiscard]] uint8_t cell(int i, int j) const {
+    if (i < 0 || j < 0 || i >= n_ || j >= n_) return kCostLethal;
+    return cost_[static_cast<size_t>(j) * static_cast<size_t>(n_) + static_cast<size_t>(i)];
+  }
+  // O(1) lookup of the cell containing (x, y) in odom.
+  [[nodiscard]] uint8_t at(double x, double y) const;
+  // Bilinear interpolation between cell centres (for the controller's smooth cost).
+  [[nodiscard]] double cost(double x, double y) const;
+  [[nodiscard]] const std::vector<uint8_t>& data() const { return cost_; }
+  [[nodiscard]] size_t obstacle_cells() const { return obstacles_; }
+
+ private:
+  int n_ = 0;
+  double res_ = 0.05;
+  double ox_ = 0, oy_ = 0;
+  Nanos stamp_{0};
+  size_t obstacles_ = 0;
+  std::vector<uint8_t> cost_;
+  // distance transform work buffers
+  std::vector<float> dist2_;
+  std::vector<float> f_, g_, z_;
+  std::vector<int> v_;
+};
+
+}  // namespace core

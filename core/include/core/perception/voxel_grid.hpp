@@ -1,0 +1,98 @@
+#pragma once
+// A rolling, robot-centred spatio-temporal voxel grid in `odom` (the idea of the
+// spatio-temporal voxel layer, on a fixed dense array):
+//   - the window (e.g. 12 m x 12 m at 5 cm, in a height band) follows the robot by whole cells;
+//     cells are addressed modulo the window size, so moving never reallocates or copies, and the
+//     cells that leave the window are emptied;
+//   - marking: the end points of the rays (deskewed lidar returns in odom) inside the height band,
+//     except inside the robot's footprint (self-filter) and around the tracked person (mask);
+//   - clearing: every voxel a ray passes through before its end point is free (3-D DDA from the
+//     sensor origin: the same rays that mark, so nothing is marked that cannot be cleared);
+//   - decay: a voxel not re-marked for `decay_s` is freed.
+// Each column of the window holds a 64-bit occupancy mask (so the height band is at most 64
+// voxels) and a per-voxel marking time. Memory is fixed at construction; nothing allocates after.
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "core/geometry/pose2.hpp"
+#include "core/time.hpp"
+
+namespace core {
+
+struct VoxelGridConfig {
+  double size_xy_m = 12.0;
+  double resolution_m = 0.05;
+  double z_min_m = 0.05;  // below: ground (not marked; rays still clear above it)
+  double z_max_m = 2.0;   // above: overhead (not marked); at most 64 voxels in the band
+  double decay_s = 5.0;
+  double clear_max_range_m = 10.0;  // rays are cleared up to this far from the sensor
+  // Self filter: the robot's body in base_link (returns inside are not obstacles).
+  double footprint_x_min_m = -0.35, footprint_x_max_m = 0.35;
+  double footprint_y_min_m = -0.30, footprint_y_max_m = 0.30;
+  double person_mask_radius_m = 0.45;  // returns this close to the tracked person: not marked
+};
+
+struct Point3 {
+  double x = 0, y = 0, z = 0;
+};
+
+struct Ray {
+  Point3 origin;  // sensor origin at the return's time (odom)
+  Point3 end;     // the return (odom)
+};
+
+struct VoxelGridStats {
+  uint64_t rays = 0;
+  uint64_t marked = 0;
+  uint64_t self_filtered = 0;
+  uint64_t person_masked = 0;
+  uint64_t out_of_band = 0;   // ground / overhead
+  uint64_t out_of_window = 0; // end point outside the window (the ray still clears)
+  uint64_t cleared = 0;       // voxels freed by rays
+  uint64_t decayed = 0;       // voxels freed by age
+};
+
+class VoxelGrid {
+ public:
+  explicit VoxelGrid(const VoxelGridConfig& config);
+
+  // Centres the window on the robot (odom). Cells that leave the window are emptied.
+  void recentre(double robot_x_m, double robot_y_m);
+  // Marks and clears with one scan's rays. `robot` is the base pose in odom for the self filter
+  // (the scan is short: one pose is accurate to a few cm), `person` the tracked person (odom).
+  void insert(std::span<const Ray> rays, const Pose2& robot, std::optional<Point2> person,
+              Nanos now);
+  // Frees voxels older than decay_s.
+  void decay(Nanos now);
+
+  [[nodiscard]] int cells_xy() const { return n_; }
+  [[nodiscard]] int cells_z() const { return nz_; }
+  [[nodiscard]] double resolution() const { return res_; }
+  // The window's lower corner in odom (metres) and in cells.
+  [[nodiscard]] double origin_x() const { return static_cast<double>(ox_) * res_; }
+  [[nodiscard]] double origin_y() const { return static_cast<double>(oy_) * res_; }
+  // Occupancy mask of the column at window cell (i, j), 0 <= i, j < cells_xy(); bit k = z layer.
+  [[nodiscard]] uint64_t column(int i, int j) const;
+  [[nodiscard]] bool occupied(double x, double y, double z) const;
+  [[nodiscard]] size_t occupied_count() const;
+  [[nodiscard]] const VoxelGridStats& stats() const { return stats_; }
+
+ private:
+  [[nodiscard]] size_t slot(int64_t cx, int64_t cy) const;  // odom cell -> storage column
+  void clear_ray(const Ray& r, int64_t end_cx, int64_t end_cy, int end_cz);
+  void empty_column(size_t col);
+
+  VoxelGridConfig cfg_;
+  double res_;
+  int n_;   // cells per side
+  int nz_;  // layers
+  int64_t ox_ = 0, oy_ = 0;  // window lower corner, odom cells
+  bool placed_ = false;
+  std::vector<uint64_t> mask_;    // per column
+  std::vector<uint16_t> stamp_;   // per voxel: marking time, 10 ms units (wraps at 655 s)
+  VoxelGridStats stats_;
+};
+
+}  // namespace core

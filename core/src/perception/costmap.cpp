@@ -1,0 +1,117 @@
+#include "core/perception/costmap.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace core {
+namespace {
+
+constexpr float kInf = 1e20f;
+
+// Felzenszwalb & Huttenlocher's 1-D squared distance transform of f (n samples) into d.
+void edt_1d(const float* f, float* d, int n, int* v, float* z) {
+  int k = 0;
+  v[0] = 0;
+  z[0] = -kInf;
+  z[1] = kInf;
+  for (int q = 1; q < n; ++q) {
+    float s = 0;
+    for (;;) {
+      const int p = v[k];
+      s = ((f[q] + static_cast<float>(q * q)) - (f[p] + static_cast<float>(p * p))) /
+          static_cast<float>(2 * q - 2 * p);
+      if (s > z[k] || k == 0) break;
+      --k;
+    }
+    if (s <= z[k]) {  // k == 0 and the new parabola dominates everywhere
+      v[0] = q;
+      z[0] = -kInf;
+      z[1] = kInf;
+      continue;
+    }
+    ++k;
+    v[k] = q;
+    z[k] = s;
+    z[k + 1] = kInf;
+  }
+  k = 0;
+  for (int q = 0; q < n; ++q) {
+    while (z[k + 1] < static_cast<float>(q)) ++k;
+    const float dq = static_cast<float>(q - v[k]);
+    d[q] = dq * dq + f[v[k]];
+  }
+}
+
+}  // namespace
+
+Costmap::Costmap(int cells, double resolution_m)
+    : n_(cells),
+      res_(resolution_m),
+      cost_(static_cast<size_t>(cells) * static_cast<size_t>(cells), 0),
+      dist2_(cost_.size(), kInf),
+      f_(static_cast<size_t>(cells)),
+      g_(static_cast<size_t>(cells)),
+      z_(static_cast<size_t>(cells) + 1),
+      v_(static_cast<size_t>(cells)) {}
+
+void Costmap::build(const VoxelGrid& grid, const CostmapConfig& config, Nanos stamp) {
+  if (n_ != grid.cells_xy() || res_ != grid.resolution()) {
+    *this = Costmap(grid.cells_xy(), grid.resolution());  // only when the grid's size changes
+  }
+  ox_ = grid.origin_x();
+  oy_ = grid.origin_y();
+  stamp_ = stamp;
+  obstacles_ = 0;
+  // Squared distance (in cells) to the nearest obstacle column: rows, then columns.
+  for (int j = 0; j < n_; ++j) {
+    for (int i = 0; i < n_; ++i) {
+      const bool obstacle = grid.column(i, j) != 0;
+      obstacles_ += obstacle ? 1U : 0U;
+      f_[static_cast<size_t>(i)] = obstacle ? 0.0f : kInf;
+    }
+    edt_1d(f_.data(), &dist2_[static_cast<size_t>(j) * static_cast<size_t>(n_)], n_, v_.data(),
+           z_.data());
+  }
+  for (int i = 0; i < n_; ++i) {
+    for (int j = 0; j < n_; ++j) {
+      f_[static_cast<size_t>(j)] = dist2_[static_cast<size_t>(j) * static_cast<size_t>(n_) +
+                                          static_cast<size_t>(i)];
+    }
+    edt_1d(f_.data(), g_.data(), n_, v_.data(), z_.data());
+    for (int j = 0; j < n_; ++j) {
+      dist2_[static_cast<size_t>(j) * static_cast<size_t>(n_) + static_cast<size_t>(i)] =
+          g_[static_cast<size_t>(j)];
+    }
+  }
+  const double r_in = config.inscribed_radius_m;
+  const double r_out = config.inflation_radius_m;
+  for (size_t c = 0; c < cost_.size(); ++c) {
+    const double d = std::sqrt(static_cast<double>(dist2_[c])) * res_;
+    uint8_t v = 0;
+    if (d <= r_in) {
+      v = kCostLethal;
+    } else if (d <= r_out) {
+      v = static_cast<uint8_t>(std::lround(99.0 * std::exp(-config.cost_scaling_per_m * (d - r_in))));
+    }
+    cost_[c] = v;
+  }
+}
+
+uint8_t Costmap::at(double x, double y) const {
+  return cell(static_cast<int>(std::floor((x - ox_) / res_)),
+              static_cast<int>(std::floor((y - oy_) / res_)));
+}
+
+double Costmap::cost(double x, double y) const {
+  const double gx = (x - ox_) / res_ - 0.5;
+  const double gy = (y - oy_) / res_ - 0.5;
+  const int i = static_cast<int>(std::floor(gx));
+  const int j = static_cast<int>(std::floor(gy));
+  const double fx = gx - i;
+  const double fy = gy - j;
+  return (1 - fx) * (1 - fy) * cell(i, j) + fx * (1 - fy) * cell(i + 1, j) +
+         (1 - fx) * fy * cell(i, j + 1) + fx * fy * cell(i + 1, j + 1);
+}
+
+}  // namespace core

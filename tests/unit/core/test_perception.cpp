@@ -1,0 +1,185 @@
+// The rolling voxel grid (marking, ray clearing, decay, rolling window, filters) and the
+// costmap (exact distance transform, the documented 0..100 mapping, lookups).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "core/perception/costmap.hpp"
+#include "core/perception/voxel_grid.hpp"
+
+using core::Nanos;
+using core::Point3;
+using core::Ray;
+using namespace std::chrono_literals;
+
+namespace {
+
+core::VoxelGridConfig small_grid() {
+  core::VoxelGridConfig c;
+  c.size_xy_m = 8.0;
+  c.resolution_m = 0.1;
+  c.z_min_m = 0.1;
+  c.z_max_m = 2.0;
+  c.decay_s = 2.0;
+  return c;
+}
+
+const Point3 kSensor{0.0, 0.0, 0.5};
+
+Ray ray_to(double x, double y, double z, Point3 origin = kSensor) {
+  return Ray{origin, Point3{x, y, z}};
+}
+
+TEST(VoxelGrid, MarksReturnsInTheHeightBandOnly) {
+  core::VoxelGrid g(small_grid());
+  g.recentre(0, 0);
+  const std::vector<Ray> rays = {ray_to(2.0, 0.0, 0.5), ray_to(2.0, 1.0, 0.02) /*ground*/,
+                                 ray_to(2.0, -1.0, 2.5) /*overhead*/};
+  g.insert(rays, {}, std::nullopt, 1s);
+  EXPECT_TRUE(g.occupied(2.0, 0.0, 0.5));
+  EXPECT_FALSE(g.occupied(2.0, 1.0, 0.02));
+  EXPECT_EQ(g.occupied_count(), 1U);
+  EXPECT_EQ(g.stats().out_of_band, 2U);
+}
+
+TEST(VoxelGrid, RaysClearWhatTheyPassThroughAndNothingElse) {
+  core::VoxelGrid g(small_grid());
+  g.recentre(0, 0);
+  // A person-height obstacle at 2 m and a low box at 3 m.
+  g.insert(std::vector<Ray>{ray_to(2.0, 0.0, 0.5), ray_to(3.0, 0.0, 0.15)}, {}, std::nullopt, 1s);
+  ASSERT_TRUE(g.occupied(2.0, 0.0, 0.5));
+  ASSERT_TRUE(g.occupied(3.0, 0.0, 0.15));
+  // The obstacle at 2 m moved away: a ray now passes through it to a wall at 3.5 m, at the same
+  // height: it is cleared. The low box is below the ray: it stays.
+  g.insert(std::vector<Ray>{ray_to(3.5, 0.0, 0.5)}, {}, std::nullopt, 1100ms);
+  EXPECT_FALSE(g.occupied(2.0, 0.0, 0.5));
+  EXPECT_TRUE(g.occupied(3.0, 0.0, 0.15));
+  EXPECT_TRUE(g.occupied(3.5, 0.0, 0.5));
+  EXPECT_GE(g.stats().cleared, 1U);
+  // A ray that ends on an occupied voxel does not clear its own end.
+  g.insert(std::vector<Ray>{ray_to(3.5, 0.0, 0.5)}, {}, std::nullopt, 1200ms);
+  EXPECT_TRUE(g.occupied(3.5, 0.0, 0.5));
+}
+
+TEST(VoxelGrid, ClearingIsLimitedToItsRange) {
+  auto cfg = small_grid();
+  cfg.clear_max_range_m = 1.0;
+  core::VoxelGrid g(cfg);
+  g.recentre(0, 0);
+  g.insert(std::vector<Ray>{ray_to(0.8, 0.0, 0.5), ray_to(2.0, 0.0, 0.5)}, {}, std::nullopt, 1s);
+  g.insert(std::vector<Ray>{ray_to(3.0, 0.0, 0.5)}, {}, std::nullopt, 1100ms);
+  EXPECT_FALSE(g.occupied(0.8, 0.0, 0.5)) << "within clear_max_range";
+  EXPECT_TRUE(g.occupied(2.0, 0.0, 0.5)) << "beyond clear_max_range: kept";
+}
+
+TEST(VoxelGrid, VoxelsDecayAndAreFreed) {
+  core::VoxelGrid g(small_grid());
+  g.recentre(0, 0);
+  g.insert(std::vector<Ray>{ray_to(2.0, 0.0, 0.5), ray_to(-2.0, 0.0, 0.5)}, {}, std::nullopt, 1s);
+  g.decay(2500ms);
+  EXPECT_EQ(g.occupied_count(), 2U);
+  // Only one is seen again.
+  g.insert(std::vector<Ray>{ray_to(2.0, 0.0, 0.5, Point3{1.0, 0.0, 0.5})}, {}, std::nullopt, 2600ms);
+  g.decay(3100ms);
+  EXPECT_EQ(g.occupied_count(), 1U);
+  EXPECT_TRUE(g.occupied(2.0, 0.0, 0.5));
+  EXPECT_EQ(g.stats().decayed, 1U);
+  g.decay(10s);
+  EXPECT_EQ(g.occupied_count(), 0U);
+}
+
+TEST(VoxelGrid, SelfFilterAndPersonMask) {
+  core::VoxelGrid g(small_grid());
+  g.recentre(5, 5);
+  const core::Pose2 robot{5.0, 5.0, M_PI / 2};  // facing +y in odom
+  const core::Point2 person{5.0, 6.2};
+  g.insert(std::vector<Ray>{ray_to(5.2, 5.0, 0.3, Point3{5, 5, 0.5}),   // on the robot's body
+                            ray_to(5.1, 6.3, 1.0, Point3{5, 5, 0.5}),   // on the person
+                            ray_to(7.0, 5.0, 0.5, Point3{5, 5, 0.5})},  // an obstacle
+           robot, person, 1s);
+  EXPECT_EQ(g.stats().self_filtered, 1U);
+  EXPECT_EQ(g.stats().person_masked, 1U);
+  EXPECT_EQ(g.occupied_count(), 1U);
+  EXPECT_TRUE(g.occupied(7.0, 5.0, 0.5));
+}
+
+TEST(VoxelGrid, WindowRollsWithTheRobotWithoutMovingObstacles) {
+  core::VoxelGrid g(small_grid());  // 8 m window
+  g.recentre(0, 0);
+  g.insert(std::vector<Ray>{ray_to(3.0, 0.0, 0.5), ray_to(-3.0, 1.0, 0.5)}, {}, std::nullopt, 1s);
+  // 2 m forward: the obstacle behind (x = -3) is now 5 m behind, outside the 4 m half-window.
+  g.recentre(2.0, 0.0);
+  EXPECT_TRUE(g.occupied(3.0, 0.0, 0.5)) << "still at its odom position";
+  EXPECT_FALSE(g.occupied(-3.0, 1.0, 0.5));
+  EXPECT_EQ(g.occupied_count(), 1U) << "the one that left was emptied";
+  // Back again: what left the window does not come back from stale storage.
+  g.recentre(0.0, 0.0);
+  EXPECT_FALSE(g.occupied(-3.0, 1.0, 0.5));
+  EXPECT_EQ(g.occupied_count(), 1U);
+  // The reused storage works at the new place.
+  g.recentre(2.0, 2.0);
+  g.insert(std::vector<Ray>{ray_to(5.5, 5.5, 0.5, Point3{2, 2, 0.5})}, {}, std::nullopt, 2s);
+  EXPECT_TRUE(g.occupied(5.5, 5.5, 0.5));
+  EXPECT_FALSE(g.occupied(-2.5, -2.5, 0.5)) << "its storage twin (8 m away) is not affected";
+  // A jump larger than the window empties everything.
+  g.recentre(100.0, 0.0);
+  EXPECT_EQ(g.occupied_count(), 0U);
+}
+
+// ---- costmap -----------------------------------------------------------------------------------
+
+TEST(Costmap, FollowsTheDocumentedMapping) {
+  core::VoxelGrid g(small_grid());
+  g.recentre(0, 0);
+  g.insert(std::vector<Ray>{ray_to(2.05, 0.05, 0.5)}, {}, std::nullopt, 1s);  // cell centre
+  core::CostmapConfig cc;  // r_in 0.35, inflation 1.2, k 3
+  core::Costmap m;
+  m.build(g, cc, 1s);
+  EXPECT_EQ(m.obstacle_cells(), 1U);
+  EXPECT_EQ(m.at(2.05, 0.05), 100);
+  EXPECT_EQ(m.at(2.05 + 0.3, 0.05), 100) << "inside the inscribed radius: lethal";
+  // 0.5 m away: 99 exp(-3 (0.5 - 0.35)) = 63.1
+  EXPECT_EQ(m.at(2.55, 0.05), 63);
+  // 0.8 m: 99 exp(-3 * 0.45) = 25.7 -> 26, below R = 30
+  EXPECT_EQ(m.at(2.05, 0.85), 26);
+  EXPECT_EQ(m.at(2.05 + 1.3, 0.05), 0) << "beyond the inflation radius";
+  EXPECT_EQ(m.at(100.0, 0.0), 100) << "outside the map is not free";
+  // Bilinear between two cell centres.
+  const double mid = m.cost(2.60, 0.05);
+  EXPECT_NEAR(mid, 0.5 * (m.at(2.55, 0.05) + m.at(2.65, 0.05)), 1e-9);
+  EXPECT_EQ(m.stamp(), 1s);
+}
+
+TEST(Costmap, DistanceTransformIsExact) {
+  auto cfg = small_grid();
+  cfg.size_xy_m = 4.0;
+  core::VoxelGrid g(cfg);
+  g.recentre(0, 0);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.95, 1.95);
+  std::vector<Ray> rays;
+  for (int i = 0; i < 25; ++i) rays.push_back(ray_to(u(rng), u(rng), 0.5, Point3{0, 0, 3.0}));
+  g.insert(rays, core::Pose2{10, 10, 0}, std::nullopt, 1s);  // robot elsewhere: no self filter
+  core::CostmapConfig cc;
+  cc.inscribed_radius_m = 0.0;
+  cc.inflation_radius_m = 10.0;
+  cc.cost_scaling_per_m = 1.0;
+  core::Costmap m;
+  m.build(g, cc, 1s);
+  const int n = m.cells();
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      double best = 1e9;
+      for (int b = 0; b < n; ++b) {
+        for (int a = 0; a < n; ++a) {
+          if (g.column(a, b) != 0) best = std::min(best, std::hypot(a - i, b - j) * 0.1);
+        }
+      }
+      const int expected = best == 0.0 ? 100 : static_cast<int>(std::lround(99.0 * std::exp(-best)));
+      ASSERT_EQ(m.cell(i, j), expected) << i << "," << j;
+    }
+  }
+}
+
+}  // namespace
