@@ -37,7 +37,8 @@ void edt_1d(const float* f, float* d, int n, int* v, float* z) {
   }
   k = 0;
   for (int q = 0; q < n; ++q) {
-    while (z[k + 1] < static_cast<float>(q)) ++k;
+    while (z[k + 1] < static_cast<float>(q))
+      ++k;
     const float dq = static_cast<float>(q - v[k]);
     d[q] = dq * dq + f[v[k]];
   }
@@ -75,8 +76,8 @@ void Costmap::build(const VoxelGrid& grid, const CostmapConfig& config, Nanos st
   }
   for (int i = 0; i < n_; ++i) {
     for (int j = 0; j < n_; ++j) {
-      f_[static_cast<size_t>(j)] = dist2_[static_cast<size_t>(j) * static_cast<size_t>(n_) +
-                                          static_cast<size_t>(i)];
+      f_[static_cast<size_t>(j)] =
+          dist2_[static_cast<size_t>(j) * static_cast<size_t>(n_) + static_cast<size_t>(i)];
     }
     edt_1d(f_.data(), g_.data(), n_, v_.data(), z_.data());
     for (int j = 0; j < n_; ++j) {
@@ -92,7 +93,8 @@ void Costmap::build(const VoxelGrid& grid, const CostmapConfig& config, Nanos st
     if (d <= r_in) {
       v = kCostLethal;
     } else if (d <= r_out) {
-      v = static_cast<uint8_t>(std::lround(99.0 * std::exp(-config.cost_scaling_per_m * (d - r_in))));
+      v = static_cast<uint8_t>(
+          std::lround(99.0 * std::exp(-config.cost_scaling_per_m * (d - r_in))));
     }
     cost_[c] = v;
   }

@@ -80,7 +80,8 @@ TEST(VoxelGrid, VoxelsDecayAndAreFreed) {
   g.decay(2500ms);
   EXPECT_EQ(g.occupied_count(), 2U);
   // Only one is seen again.
-  g.insert(std::vector<Ray>{ray_to(2.0, 0.0, 0.5, Point3{1.0, 0.0, 0.5})}, {}, std::nullopt, 2600ms);
+  g.insert(std::vector<Ray>{ray_to(2.0, 0.0, 0.5, Point3{1.0, 0.0, 0.5})}, {}, std::nullopt,
+           2600ms);
   g.decay(3100ms);
   EXPECT_EQ(g.occupied_count(), 1U);
   EXPECT_TRUE(g.occupied(2.0, 0.0, 0.5));
@@ -159,7 +160,8 @@ TEST(Costmap, DistanceTransformIsExact) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-1.95, 1.95);
   std::vector<Ray> rays;
-  for (int i = 0; i < 25; ++i) rays.push_back(ray_to(u(rng), u(rng), 0.5, Point3{0, 0, 3.0}));
+  for (int i = 0; i < 25; ++i)
+    rays.push_back(ray_to(u(rng), u(rng), 0.5, Point3{0, 0, 3.0}));
   g.insert(rays, core::Pose2{10, 10, 0}, std::nullopt, 1s);  // robot elsewhere: no self filter
   core::CostmapConfig cc;
   cc.inscribed_radius_m = 0.0;
@@ -176,10 +178,47 @@ TEST(Costmap, DistanceTransformIsExact) {
           if (g.column(a, b) != 0) best = std::min(best, std::hypot(a - i, b - j) * 0.1);
         }
       }
-      const int expected = best == 0.0 ? 100 : static_cast<int>(std::lround(99.0 * std::exp(-best)));
+      const int expected =
+          best == 0.0 ? 100 : static_cast<int>(std::lround(99.0 * std::exp(-best)));
       ASSERT_EQ(m.cell(i, j), expected) << i << "," << j;
     }
   }
+}
+
+}  // namespace
+
+#include "core/perception/deskew.hpp"
+
+namespace {
+
+TEST(Deskew, EachReturnUsesThePoseAtItsTime) {
+  // The robot drives at 1 m/s along x and turns 90 deg/s; a wall point seen at 0 and at 100 ms
+  // from different robot poses lands at the same odom position after deskewing.
+  core::PoseHistory h(64, 20ms);
+  for (int i = 0; i <= 10; ++i) {
+    const double t = 0.02 * i;
+    h.add({1.0 * t, 0.0, M_PI / 2 * t}, std::chrono::milliseconds(20 * i));
+  }
+  const core::Point3 wall{3.0, 1.0, 0.5};  // odom
+  std::vector<core::TimedPoint> in;
+  for (Nanos t : {0ms, 50ms, 100ms, 150ms}) {
+    const core::Pose2 robot = *h.at(t);
+    const core::Point2 b = robot.inverse().apply({wall.x, wall.y});
+    in.push_back({b.x_m, b.y_m, wall.z, t});
+  }
+  in.push_back({1.0, 0.0, 0.5, 500ms});  // no odometry that late: dropped
+  std::vector<core::Ray> out(in.size());
+  const auto r = core::deskew(in, h, core::Point3{0.1, 0.0, 0.45}, out, 1ns);
+  ASSERT_EQ(r.rays, 4U);
+  EXPECT_EQ(r.no_pose, 1U);
+  for (size_t i = 0; i < r.rays; ++i) {
+    EXPECT_NEAR(out[i].end.x, wall.x, 1e-9) << i;
+    EXPECT_NEAR(out[i].end.y, wall.y, 1e-9) << i;
+  }
+  // The ray starts at the sensor, 0.1 m ahead of the robot at that time (at 100 ms: x = 0.1,
+  // heading 9 deg).
+  EXPECT_NEAR(out[2].origin.x, 0.1 + 0.1 * std::cos(M_PI / 20), 1e-9);
+  EXPECT_NEAR(out[2].origin.y, 0.1 * std::sin(M_PI / 20), 1e-9);
 }
 
 }  // namespace

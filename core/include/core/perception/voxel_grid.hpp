@@ -11,6 +11,7 @@
 //   - decay: a voxel not re-marked for `decay_s` is freed.
 // Each column of the window holds a 64-bit occupancy mask (so the height band is at most 64
 // voxels) and a per-voxel marking time. Memory is fixed at construction; nothing allocates after.
+// The window side is rounded up to a multiple of 8 cells (rays skip empty 8 x 8 blocks).
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -48,10 +49,10 @@ struct VoxelGridStats {
   uint64_t marked = 0;
   uint64_t self_filtered = 0;
   uint64_t person_masked = 0;
-  uint64_t out_of_band = 0;   // ground / overhead
-  uint64_t out_of_window = 0; // end point outside the window (the ray still clears)
-  uint64_t cleared = 0;       // voxels freed by rays
-  uint64_t decayed = 0;       // voxels freed by age
+  uint64_t out_of_band = 0;    // ground / overhead
+  uint64_t out_of_window = 0;  // end point outside the window (the ray still clears)
+  uint64_t cleared = 0;        // voxels freed by rays
+  uint64_t decayed = 0;        // voxels freed by age
 };
 
 class VoxelGrid {
@@ -83,15 +84,20 @@ class VoxelGrid {
   [[nodiscard]] size_t slot(int64_t cx, int64_t cy) const;  // odom cell -> storage column
   void clear_ray(const Ray& r, int64_t end_cx, int64_t end_cy, int end_cz);
   void empty_column(size_t col);
+  void set_column(size_t col, uint64_t mask);  // keeps the block counts
+  [[nodiscard]] size_t block_of(size_t col) const;
 
   VoxelGridConfig cfg_;
   double res_;
-  int n_;   // cells per side
-  int nz_;  // layers
+  int n_;                    // cells per side
+  int nz_;                   // layers
   int64_t ox_ = 0, oy_ = 0;  // window lower corner, odom cells
   bool placed_ = false;
-  std::vector<uint64_t> mask_;    // per column
-  std::vector<uint16_t> stamp_;   // per voxel: marking time, 10 ms units (wraps at 655 s)
+  std::vector<uint64_t> mask_;   // per column
+  std::vector<uint16_t> stamp_;  // per voxel: marking time, 10 ms units (wraps at 655 s)
+  // Non-empty columns per block of kBlock x kBlock columns: rays skip empty blocks whole.
+  static constexpr int kBlock = 8;
+  std::vector<uint16_t> block_count_;
   VoxelGridStats stats_;
 };
 
