@@ -12,6 +12,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <numbers>
@@ -19,6 +20,7 @@
 #include <string>
 
 #include "firmware/config/config_loader.hpp"
+#include "firmware/lidar_pipeline.hpp"
 #include "firmware/tool_console.hpp"
 #include "hal/capture/pcap_file.hpp"
 #include "hal/linux_clock.hpp"
@@ -301,6 +303,68 @@ int cmd_listen(const std::string& bind, double duration_s) {
   return st.packets > 0 ? 0 : kExitFail;
 }
 
+// PGM (binary, P5): white = free, black = lethal; north (+y in odom) up, +x to the right.
+bool write_pgm(const std::string& path, const core::Costmap& m) {
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  if (f == nullptr) return false;
+  const int n = m.cells();
+  (void)std::fprintf(
+      f, "P5\n# companion costmap, 0..100 as 255..0, origin %.3f %.3f, %.3f m/px\n%d %d\n255\n",
+      m.origin_x(), m.origin_y(), m.resolution(), n, n);
+  std::vector<uint8_t> row(static_cast<size_t>(n));
+  for (int j = n - 1; j >= 0; --j) {
+    for (int i = 0; i < n; ++i) {
+      row[static_cast<size_t>(i)] = static_cast<uint8_t>(255 - m.cell(i, j) * 255 / 100);
+    }
+    (void)std::fwrite(row.data(), 1, row.size(), f);
+  }
+  return std::fclose(f) == 0;
+}
+
+int cmd_costmap(const std::string& path, const firmware::DaemonConfig& cfg,
+                const std::string& out_dir) {
+  std::string err;
+  auto reader = hal::PcapReader::open(path, err);
+  if (!reader) {
+    complain("%s\n", err.c_str());
+    return kExitCannotOpen;
+  }
+  std::error_code ec;
+  std::filesystem::create_directories(out_dir, ec);
+  if (ec) {
+    complain("cannot create %s: %s\n", out_dir.c_str(), ec.message().c_str());
+    return kExitCannotOpen;
+  }
+  firmware::LidarPipeline pipeline(cfg);
+  const core::PoseHistory no_odometry(1, core::Nanos(0));  // the sensor stands still
+  int scans = 0;
+  const core::Nanos t0{0};
+  while (auto udp = reader->next(2368)) {
+    vlp16::RawDataPacket raw;
+    if (vlp16::parse_data_packet(udp->payload, raw) != vlp16::DecodeError::kNone) continue;
+    // Capture time as the host's reception time (relative to the file's start).
+    const core::Costmap* m =
+        pipeline.add_packet(raw, udp->capture_time - t0, no_odometry, std::nullopt);
+    if (m == nullptr) continue;
+    const std::string file = fmt::format("{}/costmap_{:04d}.pgm", out_dir, scans);
+    if (!write_pgm(file, *m)) {
+      complain("cannot write %s\n", file.c_str());
+      return kExitCannotOpen;
+    }
+    const auto& s = pipeline.last_scan();
+    say("%s: scan %d%s, %zu returns, %zu obstacle cells, %zu voxels occupied\n", file.c_str(),
+        scans, s.partial ? " (partial)" : "", s.points, m->obstacle_cells(),
+        pipeline.grid().occupied_count());
+    ++scans;
+  }
+  if (scans == 0) {
+    say("no complete scan in %s (a scan needs a full revolution past the cut angle)\n",
+        path.c_str());
+    return kExitFail;
+  }
+  return 0;
+}
+
 int run(int argc, char** argv) {
   CLI::App app{"companion-lidar: VLP-16 tool (decode, stats, listen)"};
   app.require_subcommand(1);
@@ -321,6 +385,10 @@ int run(int argc, char** argv) {
   decode->add_flag("--sensor-frame", sensor_frame, "raw sensor axes instead of base_link");
   decode->add_option("--out", out, "write here instead of stdout");
   decode->add_flag("--strict", strict, "exit 1 when a packet does not decode");
+  std::string out_dir;
+  auto* costmap = app.add_subcommand("costmap", "voxel grid + costmap per scan, as PGM images");
+  costmap->add_option("file", file, "pcap capture")->required();
+  costmap->add_option("--out", out_dir, "directory for costmap_NNNN.pgm")->required();
   auto* stats = app.add_subcommand("stats", "packets, rate, mode, product, rpm, losses, errors");
   stats->add_option("file", file, "pcap capture")->required();
   stats->add_flag("--strict", strict, "exit 1 on any decode error or lost packet");
@@ -346,6 +414,7 @@ int run(int argc, char** argv) {
     return cmd_decode(file, *cr.config, format, per_packet, sensor_frame, out, strict);
   }
   if (app.got_subcommand("stats")) return cmd_stats(file, strict);
+  if (app.got_subcommand("costmap")) return cmd_costmap(file, *cr.config, out_dir);
   if (app.got_subcommand("listen")) return cmd_listen(bind, duration_s);
   return 3;
 }

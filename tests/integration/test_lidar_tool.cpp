@@ -2,6 +2,8 @@
 // capture's packets replayed to it over loopback at the sensor's rate).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <regex>
 #include <sstream>
@@ -148,4 +150,27 @@ TEST(LidarTool, ListensToALiveStream) {
   EXPECT_EQ(*code, 0) << out;
   EXPECT_NE(out.find("total: data packets 84"), std::string::npos) << out;
   EXPECT_NE(out.find("kernel drops 0"), std::string::npos) << out;
+}
+
+TEST(LidarTool, CostmapWritesOnePicturePerScanFromTheRealCapture) {
+  const std::string dir = ::testing::TempDir() + "costmaps";
+  std::filesystem::remove_all(dir);
+  const auto r = lidar_tool({"costmap", kCapture, "--out", dir});
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("costmap_0000.pgm: scan 0"), std::string::npos) << r.out;
+  std::ifstream in(dir + "/costmap_0000.pgm", std::ios::binary);
+  std::string magic, comment_line, size, maxval;
+  std::getline(in, magic);
+  std::getline(in, comment_line);
+  std::getline(in, size);
+  std::getline(in, maxval);
+  EXPECT_EQ(magic, "P5");
+  EXPECT_EQ(size, "240 240");  // 12 m at 5 cm
+  std::vector<unsigned char> px(240 * 240);
+  in.read(reinterpret_cast<char*>(px.data()), static_cast<std::streamsize>(px.size()));
+  ASSERT_EQ(in.gcount(), 240 * 240);
+  const auto lethal = std::count(px.begin(), px.end(), 0);
+  EXPECT_GT(lethal, 1000) << "the room's walls";
+  // The sensor stands at the centre: its own cell is free (self filter, ray clearing).
+  EXPECT_EQ(px[120 * 240 + 120], 255);
 }

@@ -203,6 +203,12 @@ void check_relations(const DaemonConfig& cfg, const YAML::Node& root, const std:
     require(amfitrack::parse_link_uri(cfg.devices.tracker, &why).has_value(), "devices.tracker",
             why);
   }
+  require(cfg.costmap.z_max_m > cfg.costmap.z_min_m &&
+              (cfg.costmap.z_max_m - cfg.costmap.z_min_m) / cfg.costmap.resolution_m <= 64.0,
+          "costmap.z_max_m",
+          "the height band z_min_m..z_max_m must be above zero and at most 64 voxels high");
+  require(cfg.costmap.inflation_radius_m >= cfg.costmap.inscribed_radius_m,
+          "costmap.inflation_radius_m", "must be >= costmap.inscribed_radius_m");
   require(cfg.tracker.reconnect_max_ms >= cfg.tracker.reconnect_first_ms,
           "tracker.reconnect_max_ms",
           "must be >= tracker.reconnect_first_ms (" +

@@ -39,6 +39,21 @@ struct DaemonConfig {
     int64_t receive_buffer_bytes = 0;
   } lidar;
 
+  struct Costmap {
+    double size_m = 0;
+    double resolution_m = 0;
+    double z_min_m = 0;
+    double z_max_m = 0;
+    double decay_s = 0;
+    double clear_max_range_m = 0;
+    double inscribed_radius_m = 0;
+    double inflation_radius_m = 0;
+    double cost_scaling_per_m = 0;
+    double footprint_x_min_m = 0, footprint_x_max_m = 0;
+    double footprint_y_min_m = 0, footprint_y_max_m = 0;
+    double person_mask_radius_m = 0;
+  } costmap;
+
   struct Human {
     double position_noise_m = 0;
     double heading_noise_rad = 0;
