@@ -15,6 +15,7 @@
 #include "firmware/task_table.hpp"
 #include "hal/can/can_bus.hpp"
 #include "hal/linux_clock.hpp"
+#include "hal/net/udp_socket.hpp"
 #include "hal/realtime.hpp"
 #include "hal/sd_notify.hpp"
 
@@ -142,6 +143,32 @@ int run(int argc, char** argv) {
                  cfg.tracker.sensor_tx_id);
   } else if (tracker_uri == "sim") {
     spdlog::warn("tracker: 'sim' needs the simulated world (issue 7); no tracker attached");
+  }
+  // The VLP-16's data stream. Without it the supervisor holds (lidar silent) and says so.
+  const std::string& lidar_uri = cfg.devices.lidar;
+  if (lidar_uri != "none" && lidar_uri != "sim") {
+    hal::UdpEndpoint ep;
+    std::string error;
+    if (!hal::parse_udp_endpoint(lidar_uri, ep, error)) {
+      spdlog::critical("devices.lidar: {}", error);
+      firmware::shutdown_logging();
+      return 1;
+    }
+    auto opened = hal::UdpReceiver::open(ep, static_cast<int>(cfg.lidar.receive_buffer_bytes));
+    if (!opened.receiver) {
+      spdlog::error("lidar: cannot open it: {}", opened.error);
+    } else {
+      if (opened.receiver->buffer_bytes() < cfg.lidar.receive_buffer_bytes) {
+        spdlog::warn(
+            "lidar: receive buffer {} bytes, asked for {} (raise net.core.rmem_max or "
+            "grant CAP_NET_ADMIN)",
+            opened.receiver->buffer_bytes(), cfg.lidar.receive_buffer_bytes);
+      }
+      spdlog::info("lidar: VLP-16 on {}:{}", ep.address, opened.receiver->port());
+      daemon.attach_lidar(std::move(opened.receiver));
+    }
+  } else if (lidar_uri == "sim") {
+    spdlog::warn("lidar: 'sim' needs the simulated world (issue 7); no lidar attached");
   }
   firmware::Executor executor(clock, firmware::group_table(), daemon.bindings());
   daemon.attach(executor);

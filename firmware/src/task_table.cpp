@@ -30,7 +30,7 @@ const std::array<TaskRow, 8>& task_table() {
       COMPANION_TASK(supervisor, 100, 50, kGroupRealtime, 70, ""),
       COMPANION_TASK(control, 100, 3000, kGroupRealtime, 60, "MPPI-CBF controller (issue 6)"),
       COMPANION_TASK(policy, 30, 500, kGroupPlanning, 50, "companion-point selection (issue 6)"),
-      COMPANION_TASK(lidar, 10, 5000, kGroupPerception, 40, "VLP-16 driver and costmap (issue 4)"),
+      COMPANION_TASK(lidar, 10, 5000, kGroupPerception, 40, ""),
       COMPANION_TASK(notify, 10, 200, kGroupReport, 20, ""),  // systemd watchdog pings
       COMPANION_TASK(report, 1, 2000, kGroupReport, 10, ""),  // status line, summaries
   }};

@@ -100,6 +100,16 @@ void Costmap::build(const VoxelGrid& grid, const CostmapConfig& config, Nanos st
   }
 }
 
+void Costmap::copy_cells_from(const Costmap& other) {
+  n_ = other.n_;
+  res_ = other.res_;
+  ox_ = other.ox_;
+  oy_ = other.oy_;
+  stamp_ = other.stamp_;
+  obstacles_ = other.obstacles_;
+  cost_.assign(other.cost_.begin(), other.cost_.end());  // no allocation once sized
+}
+
 uint8_t Costmap::at(double x, double y) const {
   return cell(static_cast<int>(std::floor((x - ox_) / res_)),
               static_cast<int>(std::floor((y - oy_) / res_)));

@@ -11,14 +11,18 @@
 #include "amfitrack/amfitrack.hpp"
 #include "amfitrack/person_frame.hpp"
 #include "core/channel/latest_value.hpp"
+#include "core/channel/snapshot_channel.hpp"
 #include "core/geometry/pose_history.hpp"
 #include "core/human/human_ekf.hpp"
+#include "core/perception/costmap.hpp"
 #include "core/safety/motion_gate.hpp"
 #include "core/safety/supervisor.hpp"
 #include "firmware/config/daemon_config.hpp"
+#include "firmware/lidar_pipeline.hpp"
 #include "firmware/logging.hpp"
 #include "firmware/scheduler/executor.hpp"
 #include "hal/can/can_bus.hpp"
+#include "hal/net/udp_socket.hpp"
 #include "hal/sd_notify.hpp"
 #include "scout_mini/scout_mini.hpp"
 
@@ -66,6 +70,19 @@ struct TrackerHealth {
   uint64_t filter_resets = 0;
 };
 
+// What the lidar task publishes about the VLP-16 stream (the costmap travels as a snapshot).
+struct LidarHealth {
+  core::Nanos packet_stamp = core::kNever;   // latest data packet that decoded
+  core::Nanos costmap_stamp = core::kNever;  // sensor time (scan end) of the newest costmap
+  uint64_t packets = 0;
+  uint64_t decode_errors = 0;
+  uint64_t lost_packets = 0;
+  uint64_t kernel_drops = 0;
+  uint64_t scans = 0;
+  size_t obstacle_cells = 0;
+  size_t last_scan_points = 0;
+};
+
 core::SupervisorConfig supervisor_config(const DaemonConfig& cfg);
 core::StopLimits stop_limits(const DaemonConfig& cfg);
 amfitrack::AmfitrackConfig amfitrack_config(const DaemonConfig& cfg);
@@ -95,6 +112,10 @@ class Daemon {
     return human_track_;
   }
   [[nodiscard]] const core::HumanEkfConfig& human_config() const { return human_config_; }
+  // The VLP-16's data socket (optional: without it the supervisor holds, lidar silent).
+  void attach_lidar(std::unique_ptr<hal::UdpReceiver> data);
+  [[nodiscard]] const core::LatestValue<LidarHealth>& lidar_health() const { return lidar_health_; }
+  [[nodiscard]] const core::SnapshotChannel<core::Costmap>& costmap() const { return costmap_; }
   // The executor running the bindings (the supervisor and the report read its statistics).
   void attach(const Executor& executor);
 
@@ -127,6 +148,7 @@ class Daemon {
  private:
   std::string safety_text(const SafetySnapshot& s) const;
   std::string tracker_text(core::Nanos now) const;
+  std::string lidar_text(core::Nanos now) const;
 
   DaemonConfig cfg_;
   hal::SystemdNotifier& notifier_;
@@ -158,6 +180,15 @@ class Daemon {
   RateLimitedLog tracker_warning_;
   core::LatestValue<TrackerHealth> tracker_health_;
   core::LatestValue<core::HumanTrack> human_track_;
+
+  // lidar (socket and pipeline owned by the lidar task)
+  std::unique_ptr<hal::UdpReceiver> lidar_rx_;
+  std::unique_ptr<LidarPipeline> lidar_;
+  core::PoseHistory lidar_odom_;
+  LidarHealth lidar_state_;
+  RateLimitedLog lidar_warning_;
+  core::LatestValue<LidarHealth> lidar_health_;
+  core::SnapshotChannel<core::Costmap> costmap_;
 
   // base (driver owned by the realtime group's thread: base and control tasks)
   std::unique_ptr<hal::CanBus> base_bus_;

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "amfitrack/open_link.hpp"
+#include "hal/net/udp_socket.hpp"
 #include "schema.hpp"
 
 namespace firmware {
@@ -202,6 +203,11 @@ void check_relations(const DaemonConfig& cfg, const YAML::Node& root, const std:
     std::string why;
     require(amfitrack::parse_link_uri(cfg.devices.tracker, &why).has_value(), "devices.tracker",
             why);
+  }
+  if (cfg.devices.lidar.rfind("udp:", 0) == 0) {
+    hal::UdpEndpoint ep;
+    std::string why;
+    require(hal::parse_udp_endpoint(cfg.devices.lidar, ep, why), "devices.lidar", why);
   }
   require(cfg.costmap.z_max_m > cfg.costmap.z_min_m &&
               (cfg.costmap.z_max_m - cfg.costmap.z_min_m) / cfg.costmap.resolution_m <= 64.0,

@@ -179,3 +179,10 @@ TEST(Config, TrackerDeviceUriIsChecked) {
   EXPECT_TRUE(
       load_config_text("devices:\n  tracker: \"serial:/dev/ttyUSB0@921600\"\n", "test.yaml").ok());
 }
+
+TEST(Config, LidarEndpointAndCostmapBandAreChecked) {
+  expect_error(load_config_text("devices:\n  lidar: \"udp:0.0.0.0:99999\"\n", "test.yaml"), 2,
+               "devices.lidar", "port '99999'");
+  expect_error(load_config_text("costmap:\n  resolution_m: 0.02\n  z_max_m: 2.0\n", "test.yaml"), 3,
+               "costmap.z_max_m", "at most 64 voxels");
+}

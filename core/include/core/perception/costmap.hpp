@@ -30,6 +30,9 @@ class Costmap {
   // Reuses this costmap's buffers (no allocation when the size does not change).
   void build(const VoxelGrid& grid, const CostmapConfig& config, Nanos stamp);
 
+  // Copies the published part (cells, origin, stamp), not the work buffers: what a snapshot needs.
+  void copy_cells_from(const Costmap& other);
+
   [[nodiscard]] int cells() const { return n_; }
   [[nodiscard]] double resolution() const { return res_; }
   [[nodiscard]] double origin_x() const { return ox_; }  // odom, lower corner
