@@ -103,7 +103,7 @@ TEST(Daemon, WithNoDevicesItHoldsBecauseTheTrackerIsSilentAndSaysSo) {
   const std::string status = d.daemon.status_line();
   EXPECT_EQ(status.rfind("HOLD: tracker silent", 0), 0U) << status;
   EXPECT_NE(status.find("control 100Hz"), std::string::npos) << status;
-  EXPECT_NE(status.find("not yet implemented: control, policy, lidar"), std::string::npos)
+  EXPECT_NE(status.find("not yet implemented: control, policy"), std::string::npos)
       << status;
   const auto sent = sock.receive_containing("STATUS=HOLD: tracker silent", 1s);
   EXPECT_TRUE(sent.has_value());
