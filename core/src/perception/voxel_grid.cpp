@@ -14,7 +14,7 @@ constexpr double kNoStep = std::numeric_limits<double>::infinity();
 // floor() without the libm call (the baseline x86-64 / aarch64 targets do not inline it).
 inline int64_t floor_to_int(double v) {
   const auto i = static_cast<int64_t>(v);
-  return v < static_cast<double>(i) ? i - 1 : i;
+  return i - static_cast<int64_t>(v < static_cast<double>(i));  // branchless
 }
 
 uint16_t stamp_units(Nanos now) {
@@ -33,7 +33,9 @@ VoxelGrid::VoxelGrid(const VoxelGridConfig& config)
           64)),
       mask_(static_cast<size_t>(n_) * static_cast<size_t>(n_), 0),
       stamp_(mask_.size() * static_cast<size_t>(nz_), 0),
-      block_count_(static_cast<size_t>(n_ / kBlock) * static_cast<size_t>(n_ / kBlock), 0) {}
+      block_count_(static_cast<size_t>(n_ / kBlock) * static_cast<size_t>(n_ / kBlock), 0),
+      traced_(1 << 17, 0),
+      traced_scan_(traced_.size(), 0) {}
 
 size_t VoxelGrid::block_of(size_t col) const {
   const size_t i = col % static_cast<size_t>(n_);
@@ -157,10 +159,10 @@ void VoxelGrid::clear_ray(const Ray& r, int64_t end_cx, int64_t end_cy, int end_
   double t = t0;
   while (t < t1) {
     const auto col = static_cast<size_t>(sj * n_ + si);
-    if (block_count_[static_cast<size_t>((sj / kBlock) * blocks_per_row + si / kBlock)] == 0) {
+    if (block_count_[static_cast<size_t>((sj >> 3) * blocks_per_row + (si >> 3))] == 0) {
       // Nothing to clear in this 8 x 8 block: continue from where the ray leaves it.
-      const auto bx = static_cast<double>(floor_to_int(static_cast<double>(cx) * (1.0 / kBlock)));
-      const auto by = static_cast<double>(floor_to_int(static_cast<double>(cy) * (1.0 / kBlock)));
+      const auto bx = static_cast<double>(cx >> 3);  // arithmetic shift: floor(cx / kBlock)
+      const auto by = static_cast<double>(cy >> 3);
       const double tx = adx < 1e-12 ? kNoStep : ((bx + (sx > 0 ? 1 : 0)) * block_m - x0) * inv_dx;
       const double ty = ady < 1e-12 ? kNoStep : ((by + (sy > 0 ? 1 : 0)) * block_m - y0) * inv_dy;
       const double t_exit = std::min(tx, ty);
@@ -222,10 +224,31 @@ void VoxelGrid::insert(std::span<const Ray> rays, const Pose2& robot, std::optio
                        Nanos now) {
   // Clear with every ray first, then mark: a grazing ray of this scan must not erase a return
   // of the same scan.
+  ++scan_serial_;
+  const size_t table_mask = traced_.size() - 1;
   for (const Ray& r : rays) {
     const int64_t cx = static_cast<int64_t>(std::floor(r.end.x / res_));
     const int64_t cy = static_cast<int64_t>(std::floor(r.end.y / res_));
     const int cz = static_cast<int>(std::floor((r.end.z - cfg_.z_min_m) / res_));
+    // One ray per end voxel and scan (a table stamped with the scan's serial: no clearing pass).
+    const uint64_t key = (static_cast<uint64_t>(cx) & 0x1FFFFF) |
+                         (static_cast<uint64_t>(cy) & 0x1FFFFF) << 21 |
+                         (static_cast<uint64_t>(cz + 1024) & 0x1FFFFF) << 42;
+    size_t h = static_cast<size_t>((key * 0x9E3779B97F4A7C15ULL) >> 40) & table_mask;
+    bool seen = false;
+    for (size_t probe = 0; probe < 8; ++probe, h = (h + 1) & table_mask) {
+      if (traced_scan_[h] != scan_serial_) {
+        traced_scan_[h] = scan_serial_;
+        traced_[h] = key;
+        break;
+      }
+      if (traced_[h] == key) {
+        seen = true;
+        break;
+      }
+    }
+    if (seen) continue;
+    ++stats_.rays_traced;
     clear_ray(r, cx, cy, cz);
   }
   const Pose2 odom_to_base = robot.inverse();
@@ -298,6 +321,12 @@ bool VoxelGrid::occupied(double x, double y, double z) const {
     return false;
   }
   return (mask_[slot(cx, cy)] >> cz & 1U) != 0;
+}
+
+size_t VoxelGrid::memory_bytes() const {
+  return mask_.capacity() * sizeof(uint64_t) + stamp_.capacity() * sizeof(uint16_t) +
+         block_count_.capacity() * sizeof(uint16_t) + traced_.capacity() * sizeof(uint64_t) +
+         traced_scan_.capacity() * sizeof(uint32_t);
 }
 
 size_t VoxelGrid::occupied_count() const {

@@ -128,6 +128,56 @@ TEST(VoxelGrid, WindowRollsWithTheRobotWithoutMovingObstacles) {
   EXPECT_EQ(g.occupied_count(), 0U);
 }
 
+TEST(VoxelGrid, MemoryDoesNotGrowAndDecayedVoxelsAreFreed) {
+  // A robot driving a long way through random clutter for 100 s of scans.
+  core::VoxelGrid g(small_grid());
+  const size_t bytes = g.memory_bytes();
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-4.0, 4.0);
+  std::uniform_real_distribution<double> h(0.0, 2.5);
+  size_t max_occupied = 0;
+  for (int scan = 0; scan < 1000; ++scan) {
+    const double x = 0.05 * scan;  // 0.5 m/s
+    g.recentre(x, 0.0);
+    std::vector<Ray> rays;
+    for (int i = 0; i < 500; ++i) {
+      rays.push_back(ray_to(x + u(rng), u(rng), h(rng), Point3{x, 0.0, 0.5}));
+    }
+    const Nanos now = std::chrono::milliseconds(100 * scan);
+    g.insert(rays, core::Pose2{x, 0, 0}, std::nullopt, now);
+    g.decay(now);
+    max_occupied = std::max(max_occupied, g.occupied_count());
+  }
+  EXPECT_EQ(g.memory_bytes(), bytes);
+  // At most decay_s (2 s = 20 scans) of marks survive: bounded by 20 x 500.
+  EXPECT_LE(max_occupied, 20U * 500U);
+  EXPECT_GT(g.stats().decayed + g.stats().cleared, g.stats().marked / 2)
+      << "marks are freed (by rays and by age; the rest left the window), not hidden";
+}
+
+TEST(VoxelGrid, AWalkingPersonLeavesNoTrail) {
+  // An obstacle moves 1 m sideways per second in front of a wall; without the person mask
+  // (it is not the tracked person). The rays through its old places clear them scan by scan:
+  // within the decay time nothing but its current place and the wall is left.
+  core::VoxelGrid g(small_grid());
+  g.recentre(0, 0);
+  for (int scan = 0; scan <= 30; ++scan) {
+    const double y = -1.5 + 0.1 * scan;  // 1 m/s at 10 Hz
+    std::vector<Ray> rays;
+    for (double yy = -2.0; yy <= 2.0; yy += 0.02) {
+      const bool blocked = std::abs(yy - y) < 0.15;
+      rays.push_back(ray_to(blocked ? 2.0 : 3.5, blocked ? yy * 2.0 / 3.5 : yy, 0.5));
+    }
+    const Nanos now = std::chrono::milliseconds(100 * scan);
+    g.insert(rays, {}, std::nullopt, now);
+    g.decay(now);
+  }
+  // The obstacle's start (y = -1.5 at 2 m, scaled) is clear again; the wall is intact.
+  EXPECT_FALSE(g.occupied(2.0, -1.5 * 2.0 / 3.5, 0.5));
+  EXPECT_TRUE(g.occupied(3.5, -1.5, 0.5));
+  EXPECT_TRUE(g.occupied(2.0, 1.5 * 2.0 / 3.5, 0.5)) << "where it is now";
+}
+
 // ---- costmap -----------------------------------------------------------------------------------
 
 TEST(Costmap, FollowsTheDocumentedMapping) {

@@ -3,6 +3,7 @@
 // malformed variant rejected for its reason, round trips in all return modes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <set>
@@ -97,6 +98,12 @@ TEST(Vlp16, RealCapturesDecodeWithZeroErrorsAndHoldTheInvariants) {
       std::array<vlp16::Point, vlp16::kReturnsPerPacket> pts;
       const size_t n = vlp16::decode_points(raw, all, pts);
       EXPECT_LE(n, vlp16::kReturnsPerPacket);
+      // 384 returns per packet: every channel decodes to a point or has no return (distance 0).
+      size_t no_return = 0;
+      for (const auto& blk : raw.blocks) {
+        no_return += static_cast<size_t>(std::count(blk.distance.begin(), blk.distance.end(), 0));
+      }
+      EXPECT_EQ(n + no_return, vlp16::kReturnsPerPacket);
       for (size_t k = 1; k < n; ++k) {
         if (pts[k].block == pts[k - 1].block) {
           EXPECT_GT(pts[k].channel, pts[k - 1].channel);

@@ -52,6 +52,7 @@ struct VoxelGridStats {
   uint64_t out_of_band = 0;    // ground / overhead
   uint64_t out_of_window = 0;  // end point outside the window (the ray still clears)
   uint64_t cleared = 0;        // voxels freed by rays
+  uint64_t rays_traced = 0;    // rays cast for clearing (one per end voxel and scan)
   uint64_t decayed = 0;        // voxels freed by age
 };
 
@@ -78,6 +79,8 @@ class VoxelGrid {
   [[nodiscard]] uint64_t column(int i, int j) const;
   [[nodiscard]] bool occupied(double x, double y, double z) const;
   [[nodiscard]] size_t occupied_count() const;
+  // Bytes held by the grid's buffers (fixed at construction).
+  [[nodiscard]] size_t memory_bytes() const;
   [[nodiscard]] const VoxelGridStats& stats() const { return stats_; }
 
  private:
@@ -96,8 +99,13 @@ class VoxelGrid {
   std::vector<uint64_t> mask_;   // per column
   std::vector<uint16_t> stamp_;  // per voxel: marking time, 10 ms units (wraps at 655 s)
   // Non-empty columns per block of kBlock x kBlock columns: rays skip empty blocks whole.
-  static constexpr int kBlock = 8;
+  static constexpr int kBlock = 8;  // the ray loop divides by shifting 3 bits
   std::vector<uint16_t> block_count_;
+  // End voxels already traced in this scan (open addressing, cleared per insert): rays that end
+  // in the same voxel cross the same voxels to within a fraction of one, so one is cast.
+  std::vector<uint64_t> traced_;
+  std::vector<uint32_t> traced_scan_;
+  uint32_t scan_serial_ = 0;
   VoxelGridStats stats_;
 };
 
