@@ -181,7 +181,7 @@ void VoxelGrid::clear_ray(const Ray& r, int64_t end_cx, int64_t end_cy, int end_
           ady < 1e-12 ? kNoStep : (static_cast<double>(cy + (sy > 0 ? 1 : 0)) * res_ - y0) * inv_dy;
       continue;
     }
-    const double t_next = std::min({tmx, tmy, t1});
+    const double t_next = std::min(std::min(tmx, tmy), t1);
     const uint64_t m = mask_[col];
     if (m != 0) {
       const double za = (z0 + dz * t - zlo) * inv_res;
@@ -203,19 +203,17 @@ void VoxelGrid::clear_ray(const Ray& r, int64_t end_cx, int64_t end_cy, int end_
     }
     if (t_next >= t1) break;
     t = t_next;
-    if (tmx <= tmy) {
-      tmx += tdx;
-      cx += sx;
-      si += sx;
-      if (si == n_) si = 0;
-      if (si < 0) si = n_ - 1;
-    } else {
-      tmy += tdy;
-      cy += sy;
-      sj += sy;
-      if (sj == n_) sj = 0;
-      if (sj < 0) sj = n_ - 1;
-    }
+    // Branch-free step (the x-or-y choice is unpredictable): selects instead of jumps.
+    const int64_t step_x = tmx <= tmy ? 1 : 0;
+    const int64_t step_y = 1 - step_x;
+    tmx += step_x != 0 ? tdx : 0.0;
+    tmy += step_y != 0 ? tdy : 0.0;
+    cx += step_x * sx;
+    cy += step_y * sy;
+    si += step_x * sx;
+    sj += step_y * sy;
+    si = si == n_ ? 0 : (si < 0 ? n_ - 1 : si);
+    sj = sj == n_ ? 0 : (sj < 0 ? n_ - 1 : sj);
     if (cx < ox_ || cx >= ox_ + n_ || cy < oy_ || cy >= oy_ + n_) break;
   }
 }
