@@ -34,6 +34,14 @@ Result lidar_tool(std::vector<std::string> args) {
   return {code.value_or(-1), p.output()};
 }
 
+size_t count_lines_with(const std::string& text, const std::string& what) {
+  std::istringstream in(text);
+  size_t n = 0;
+  for (std::string line; std::getline(in, line);)
+    n += line.find(what) != std::string::npos;
+  return n;
+}
+
 const std::string kCapture = std::string(COMPANION_TEST_DATA) + "/vlp16/vlp16_strongest.pcap";
 const std::string k2014 = std::string(COMPANION_TEST_DATA) + "/vlp16/vlp16_2014_strongest.pcap";
 
@@ -173,4 +181,29 @@ TEST(LidarTool, CostmapWritesOnePicturePerScanFromTheRealCapture) {
   EXPECT_GT(lethal, 1000) << "the room's walls";
   // The sensor stands at the centre: its own cell is free (self filter, ray clearing).
   EXPECT_EQ(px[120 * 240 + 120], 255);
+}
+
+TEST(LidarTool, PcapWeWriteIsReadByTcpdump) {
+  // Interop: a capture written by our PcapWriter (the real packets, re-recorded) opens in
+  // tcpdump (libpcap's reference reader; Wireshark and VeloView read the same format).
+  std::string err;
+  auto reader = hal::PcapReader::open(kCapture, err);
+  ASSERT_TRUE(reader) << err;
+  const std::string out = ::testing::TempDir() + "rerecorded.pcap";
+  {
+    auto w = hal::PcapWriter::open(out, err);
+    ASSERT_TRUE(w) << err;
+    while (auto p = reader->next(2368))
+      w->write(*p);
+  }
+  ChildProcess p({"/usr/bin/tcpdump", "-r", out, "-nn", "-tt", "udp", "port", "2368"});
+  ASSERT_TRUE(p.started());
+  const auto code = p.wait(30s);
+  ASSERT_TRUE(code.has_value());
+  const std::string text = p.output();
+  EXPECT_EQ(*code, 0) << text;
+  EXPECT_EQ(count_lines_with(text, "UDP, length 1206"), 84U) << text;
+  EXPECT_NE(text.find("1525347606.362040 IP 192.168.1.200.2368 > 255.255.255.255.2368"),
+            std::string::npos)
+      << "capture time and addresses kept: " << text.substr(0, 300);
 }
