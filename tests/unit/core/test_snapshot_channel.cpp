@@ -16,12 +16,12 @@ struct Big {
 
 TEST(SnapshotChannel, EmptyUntilPublishedThenTheNewest) {
   core::SnapshotChannel<Big> ch;
-  EXPECT_EQ(ch.latest(), nullptr);
+  EXPECT_FALSE(ch.latest());
   Big* b = ch.begin_write();
   ASSERT_NE(b, nullptr);
   b->v.fill(1);
   ch.publish();
-  ASSERT_NE(ch.latest(), nullptr);
+  ASSERT_TRUE(ch.latest());
   EXPECT_EQ(ch.latest()->v[100], 1U);
   EXPECT_EQ(ch.published(), 1U);
 }
@@ -30,7 +30,7 @@ TEST(SnapshotChannel, AHeldSnapshotNeverChangesAndTheWriterSkipsWhenAllAreHeld) 
   core::SnapshotChannel<Big> ch(Big{}, 2);
   ch.begin_write()->v.fill(1);
   ch.publish();
-  const auto held = ch.latest();  // a reader keeps version 1
+  const auto held = ch.latest();  // a reader keeps version 1 pinned
   Big* b = ch.begin_write();
   ASSERT_NE(b, nullptr);
   EXPECT_NE(b, held.get());

@@ -103,8 +103,7 @@ TEST(Daemon, WithNoDevicesItHoldsBecauseTheTrackerIsSilentAndSaysSo) {
   const std::string status = d.daemon.status_line();
   EXPECT_EQ(status.rfind("HOLD: tracker silent", 0), 0U) << status;
   EXPECT_NE(status.find("control 100Hz"), std::string::npos) << status;
-  EXPECT_NE(status.find("not yet implemented: control, policy"), std::string::npos)
-      << status;
+  EXPECT_NE(status.find("not yet implemented: control, policy"), std::string::npos) << status;
   const auto sent = sock.receive_containing("STATUS=HOLD: tracker silent", 1s);
   EXPECT_TRUE(sent.has_value());
 }
@@ -517,7 +516,7 @@ TEST(DaemonWithLidar, BuildsTheCostmapAndFeedsTheSupervisor) {
   EXPECT_EQ(health->value.decode_errors, 0U);
   EXPECT_EQ(health->value.lost_packets, 0U);
   const auto map = d->daemon.costmap().latest();
-  ASSERT_NE(map, nullptr);
+  ASSERT_TRUE(map);
   // The wall (3 m from the sensor, which is 0.10 m ahead of base_link) is lethal; the middle of
   // the room is free; the robot's own cell is free.
   EXPECT_EQ(map->at(3.1, 0.0), core::kCostLethal);
