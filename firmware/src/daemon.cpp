@@ -291,7 +291,12 @@ void Daemon::lidar_task(const core::Tick& tick) {
     }
     ++lidar_state_.packets;
     lidar_state_.packet_stamp = d.stamp;
+    const uint64_t unplaced = lidar_->scans_without_pose();
     const core::Costmap* m = lidar_->add_packet(raw, d.stamp, lidar_odom_, person);
+    if (lidar_->scans_without_pose() != unplaced) {
+      lidar_warning_.warn(tick.now, "lidar: scan not used: no odometry at its time ({} so far)",
+                          lidar_->scans_without_pose());
+    }
     if (m == nullptr) return;
     ++lidar_state_.scans;
     lidar_state_.costmap_stamp = m->stamp();

@@ -73,12 +73,18 @@ const core::Costmap* LidarPipeline::add_packet(const vlp16::RawDataPacket& packe
   }
   const core::DeskewResult d =
       core::deskew(std::span(timed_.data(), n), *poses, sensor_origin_, rays_);
+  last_ = ScanReport{n, d.rays, d.no_pose, scan->lost_packets, scan->partial};
+  if (n > 0 && d.rays == 0) {
+    // Returns but no odometry for any of them (the base is silent): nothing can be placed, and
+    // a costmap built anyway would look fresh while it is not. No update.
+    ++scans_without_pose_;
+    return nullptr;
+  }
   const core::Pose2 robot = poses->at(scan->end).value_or(core::Pose2{});
   grid_.recentre(robot.x_m, robot.y_m);
   grid_.insert(std::span(rays_.data(), d.rays), robot, person, scan->end);
   grid_.decay(scan->end);
   costmap_.build(grid_, costmap_config_, scan->end);
-  last_ = ScanReport{n, d.rays, d.no_pose, scan->lost_packets, scan->partial};
   return &costmap_;
 }
 

@@ -43,6 +43,8 @@ class LidarPipeline {
   [[nodiscard]] const vlp16::ScanAssembler& assembler() const { return assembler_; }
   [[nodiscard]] const core::VoxelGrid& grid() const { return grid_; }
   [[nodiscard]] const ScanReport& last_scan() const { return last_; }
+  // Scans dropped because no odometry covered their time (the costmap was not updated).
+  [[nodiscard]] uint64_t scans_without_pose() const { return scans_without_pose_; }
 
  private:
   core::CostmapConfig costmap_config_;
@@ -55,6 +57,7 @@ class LidarPipeline {
   std::vector<core::Ray> rays_;
   core::PoseHistory still_;  // the odom origin, when there is no odometry
   ScanReport last_;
+  uint64_t scans_without_pose_ = 0;
 };
 
 }  // namespace firmware
