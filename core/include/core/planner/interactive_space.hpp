@@ -1,0 +1,71 @@
+#pragma once
+// The paper's human-robot interactive space (section III):
+//   W: n design points on the ellipse (a, b) around the person, in the human frame
+//      q^h_i = (a cos phi_i, b sin phi_i), phi_i = 2 pi (i - 1) / n, moved into base_link with the
+//      person's pose (the point's heading is the person's heading);
+//   P: the points of W whose costmap cost l(q) is below R (cost scale:
+//   core/perception/costmap.hpp); G(P_i) = alpha |P_i - q_h| + beta |P_i| + gamma l(P_i) (distances
+//   in base_link, metres); the objective selector picks argmin G over P. With P empty (the person
+//   is surrounded) there is no goal, and the reason says so.
+// Pure; fixed-size buffers set at construction.
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "core/geometry/pose2.hpp"
+#include "core/perception/costmap.hpp"
+
+namespace core {
+
+struct InteractiveSpaceConfig {
+  int points = 64;               // n
+  double a_m = 1.0;              // semi-axis along the person's heading
+  double b_m = 0.7;              // semi-axis to the person's side
+  double cost_threshold = 30.0;  // R: a point with l(q) >= R is not in P
+  double alpha = 1.0;            // weight of the distance to the person
+  double beta = 0.5;             // weight of the distance to the robot
+  double gamma = 0.02;           // weight of the costmap cost
+};
+
+struct Candidate {
+  Pose2 base;   // in base_link; theta = the person's heading
+  Point2 odom;  // where the costmap is looked up
+  double dist_human_m = 0;
+  double dist_robot_m = 0;
+  double cost = 0;       // l(q), 0..100
+  double objective = 0;  // G
+  bool free = false;     // in P
+};
+
+class InteractiveSpace {
+ public:
+  explicit InteractiveSpace(const InteractiveSpaceConfig& config);
+
+  // W and P for the person (base_link) seen from the robot (its pose in odom, for the costmap).
+  void update(const Pose2& person_base, const Pose2& robot_odom, const Costmap& costmap);
+
+  [[nodiscard]] std::span<const Candidate> candidates() const { return candidates_; }
+  [[nodiscard]] size_t free_count() const { return free_count_; }
+  [[nodiscard]] const InteractiveSpaceConfig& config() const { return config_; }
+
+ private:
+  InteractiveSpaceConfig config_;
+  std::vector<double> cos_phi_, sin_phi_;
+  std::vector<Candidate> candidates_;
+  size_t free_count_ = 0;
+};
+
+enum class GoalStatus : uint8_t { kOk = 0, kNoFreePoint, kNoPerson, kNoCostmap };
+std::string_view to_string(GoalStatus s);
+
+struct Selection {
+  GoalStatus status = GoalStatus::kNoPerson;
+  int index = -1;   // into W (0 .. n - 1)
+  Pose2 goal_base;  // q^d in base_link
+};
+
+// The objective selector: argmin G over P (ties: the lowest index, so it is deterministic).
+Selection select_by_objective(const InteractiveSpace& space);
+
+}  // namespace core

@@ -1,0 +1,110 @@
+// The interactive space W, the collision-free set P and the objective selector (paper, sec. III).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "core/perception/costmap.hpp"
+#include "core/perception/voxel_grid.hpp"
+#include "core/planner/interactive_space.hpp"
+
+using std::numbers::pi;
+using namespace std::chrono_literals;
+
+namespace {
+
+// A costmap of an empty 8 m room, or with a wall along y = wall_y (odom), 0.5 m high.
+core::Costmap room(std::optional<double> wall_y) {
+  core::VoxelGridConfig gc;
+  gc.size_xy_m = 8.0;
+  gc.resolution_m = 0.05;
+  core::VoxelGrid g(gc);
+  g.recentre(0, 0);
+  std::vector<core::Ray> rays;
+  if (wall_y) {
+    for (double x = -3.9; x <= 3.9; x += 0.02) {
+      rays.push_back({{0.0, 0.0, 3.0}, {x, *wall_y, 0.5}});
+    }
+  }
+  g.insert(rays, core::Pose2{20, 20, 0}, std::nullopt, 1s);
+  core::Costmap m;
+  m.build(g, core::CostmapConfig{}, 1s);
+  return m;
+}
+
+TEST(InteractiveSpace, PointsLieOnTheEllipseAroundThePersonInBaseLink) {
+  core::InteractiveSpaceConfig cfg;
+  cfg.points = 4;
+  core::InteractiveSpace w(cfg);
+  // The person 2 m ahead, facing left (+y).
+  w.update(core::Pose2{2.0, 0.0, pi / 2}, core::Pose2{}, room(std::nullopt));
+  const auto c = w.candidates();
+  ASSERT_EQ(c.size(), 4U);
+  // phi = 0: a = 1 m along the person's heading -> (2, 1); phi = 90 deg: b = 0.7 m to the
+  // person's left -> (1.3, 0); phi = 180 deg: behind -> (2, -1).
+  EXPECT_NEAR(c[0].base.x_m, 2.0, 1e-12);
+  EXPECT_NEAR(c[0].base.y_m, 1.0, 1e-12);
+  EXPECT_NEAR(c[1].base.x_m, 1.3, 1e-12);
+  EXPECT_NEAR(c[1].base.y_m, 0.0, 1e-12);
+  EXPECT_NEAR(c[2].base.y_m, -1.0, 1e-12);
+  for (const auto& p : c) {
+    EXPECT_NEAR(p.base.theta_rad, pi / 2, 1e-12) << "desired heading = the person's";
+    EXPECT_TRUE(p.free);
+  }
+  EXPECT_NEAR(c[1].dist_robot_m, 1.3, 1e-12);
+  EXPECT_NEAR(c[1].dist_human_m, 0.7, 1e-12);
+  // G = alpha |P - q_h| + beta |P| + gamma l
+  EXPECT_NEAR(c[1].objective, 1.0 * 0.7 + 0.5 * 1.3 + 0.02 * 0.0, 1e-12);
+  // With the robot elsewhere in odom, the costmap is looked up at the odom position.
+  w.update(core::Pose2{2.0, 0.0, pi / 2}, core::Pose2{1.0, 1.0, pi}, room(std::nullopt));
+  EXPECT_NEAR(w.candidates()[1].odom.x_m, 1.0 - 1.3, 1e-12);
+  EXPECT_NEAR(w.candidates()[1].odom.y_m, 1.0, 1e-12);
+}
+
+TEST(InteractiveSpace, PExcludesPointsInObstaclesAndArgminPicksTheOpenSide) {
+  // The person walks along +x, 1 m ahead of the robot, with a wall 0.9 m to their left.
+  core::InteractiveSpace w(core::InteractiveSpaceConfig{});
+  const core::Pose2 person{1.0, 0.0, 0.0};
+  w.update(person, core::Pose2{}, room(0.9));
+  EXPECT_LT(w.free_count(), 64U);
+  for (const auto& c : w.candidates()) {
+    if (c.base.y_m > 0.5) {
+      EXPECT_FALSE(c.free) << "within 0.4 m of the wall: cost >= R";
+      EXPECT_GE(c.cost, 30.0);
+    }
+  }
+  const auto s = core::select_by_objective(w);
+  ASSERT_EQ(s.status, core::GoalStatus::kOk);
+  EXPECT_LT(s.goal_base.y_m, 0.1) << "beside/behind, on the open side, not by the wall";
+  // Without the wall the same situation may use either side; the choice is deterministic.
+  core::InteractiveSpace open(core::InteractiveSpaceConfig{});
+  open.update(person, core::Pose2{}, room(std::nullopt));
+  const auto s1 = core::select_by_objective(open);
+  const auto s2 = core::select_by_objective(open);
+  EXPECT_EQ(s1.index, s2.index);
+  EXPECT_EQ(open.free_count(), 64U);
+}
+
+TEST(InteractiveSpace, ASurroundedPersonGivesNoGoalWithAReason) {
+  core::InteractiveSpace w(core::InteractiveSpaceConfig{});
+  // A ring of obstacles 0.9 m around the person (a crowd): every ellipse point is too close.
+  core::VoxelGridConfig gc;
+  gc.size_xy_m = 8.0;
+  core::VoxelGrid g(gc);
+  g.recentre(0, 0);
+  std::vector<core::Ray> rays;
+  for (double a = 0; a < 2 * pi; a += 0.01) {
+    rays.push_back({{2.0, 0.0, 3.0}, {2.0 + 0.9 * std::cos(a), 0.9 * std::sin(a), 0.5}});
+  }
+  g.insert(rays, core::Pose2{-20, -20, 0}, std::nullopt, 1s);
+  core::Costmap m;
+  m.build(g, core::CostmapConfig{}, 1s);
+  w.update(core::Pose2{2.0, 0.0, 0.0}, core::Pose2{}, m);
+  EXPECT_EQ(w.free_count(), 0U);
+  const auto s = core::select_by_objective(w);
+  EXPECT_EQ(s.status, core::GoalStatus::kNoFreePoint);
+  EXPECT_EQ(s.index, -1);
+  EXPECT_EQ(core::to_string(s.status), "no free point around the person");
+}
+
+}  // namespace
