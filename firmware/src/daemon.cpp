@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -91,6 +92,28 @@ core::TrackerConfidence to_tracker_confidence(amfitrack::Confidence c) {
   return core::TrackerConfidence::kUnknown;
 }
 
+core::InteractiveSpaceConfig interactive_space_config(const DaemonConfig& cfg) {
+  core::InteractiveSpaceConfig c;
+  c.points = static_cast<int>(cfg.interactive_space.points);
+  c.a_m = cfg.interactive_space.ellipse_a_m;
+  c.b_m = cfg.interactive_space.ellipse_b_m;
+  c.cost_threshold = cfg.interactive_space.cost_threshold;
+  c.alpha = cfg.objective.alpha;
+  c.beta = cfg.objective.beta;
+  c.gamma = cfg.objective.gamma;
+  return c;
+}
+
+const char* side_of_person(int index, int points) {
+  if (index < 0 || points <= 0) return "-";
+  // phi = 0 is ahead of the person, counter-clockwise: 90 deg is their left.
+  const int octant = (8 * index + points / 2) / points % 8;  // nearest eighth of the circle
+  static constexpr std::array<const char*, 8> kSide = {"front",       "front-left", "left",
+                                                       "behind-left", "behind",     "behind-right",
+                                                       "right",       "front-right"};
+  return kSide[static_cast<size_t>(octant)];
+}
+
 namespace {
 // Odometry kept for placing tracker frames: 64 poses at 50 Hz = 1.3 s; a frame newer than the
 // newest pose uses it for up to 40 ms (two base periods).
@@ -110,6 +133,7 @@ Daemon::Daemon(const DaemonConfig& cfg, hal::SystemdNotifier& notifier)
       tracker_warning_(core::from_ms(cfg.logging.warning_interval_ms)),
       lidar_odom_(kOdomHistory, kOdomHold),
       lidar_warning_(core::from_ms(cfg.logging.warning_interval_ms)),
+      space_(interactive_space_config(cfg)),
       gate_(stop_limits(cfg)),
       base_send_warning_(core::from_ms(cfg.logging.warning_interval_ms)) {}
 
@@ -311,7 +335,33 @@ void Daemon::lidar_task(const core::Tick& tick) {
   lidar_state_.kernel_drops = lidar_rx_->stats().kernel_drops;
   lidar_health_.publish(lidar_state_, tick.now);
 }
-void Daemon::policy_task(const core::Tick& /*tick*/) {}
+// ---- policy: the companion point q^d (objective argmin; the learned policy: issue 6) -----------
+
+void Daemon::policy_task(const core::Tick& tick) {
+  CompanionGoal g;
+  g.points = space_.config().points;
+  const auto track = human_track_.read();
+  const auto map = costmap_.latest();
+  core::Pose2 robot_odom;
+  if (const auto b = base_health_.read(); b && b->value.odom_stamp != core::kNever) {
+    robot_odom = b->value.odom;
+  }
+  if (!track || !track->value.valid) {
+    g.status = core::GoalStatus::kNoPerson;
+  } else if (!map) {
+    g.status = core::GoalStatus::kNoCostmap;
+  } else {
+    const core::HumanState h = core::human_state(track->value, tick.now, robot_odom, human_config_);
+    space_.update(h.pose_base, robot_odom, *map);
+    const core::Selection s = core::select_by_objective(space_);
+    g.status = s.status;
+    g.index = s.index;
+    g.free_points = space_.free_count();
+    g.goal_base = s.goal_base;
+    g.goal_odom = robot_odom * s.goal_base;
+  }
+  goal_.publish(g, tick.now);
+}
 
 // ---- control: everything that can move the robot passes the supervisor's gate ---------------
 
@@ -481,6 +531,14 @@ void Daemon::report_task(const core::Tick& tick) {
   }
   if (tracker_) line += " | " + tracker_text(tick.now);
   if (lidar_) line += " | " + lidar_text(tick.now);
+  if (const auto g = goal_.read(); g && (tracker_ || lidar_)) {
+    const CompanionGoal& v = g->value;
+    line += v.status == core::GoalStatus::kOk
+                ? fmt::format(" | goal {} {} of the person ({:+.2f}, {:+.2f}) m, {}/{} free",
+                              v.selector, side_of_person(v.index, v.points), v.goal_base.x_m,
+                              v.goal_base.y_m, v.free_points, v.points)
+                : fmt::format(" | goal none: {}", core::to_string(v.status));
+  }
   line += " | " + rates;
   if (!shells.empty()) line += " | not yet implemented: " + shells;
   status_ = line;

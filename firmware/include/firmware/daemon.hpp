@@ -15,6 +15,7 @@
 #include "core/geometry/pose_history.hpp"
 #include "core/human/human_ekf.hpp"
 #include "core/perception/costmap.hpp"
+#include "core/planner/interactive_space.hpp"
 #include "core/safety/motion_gate.hpp"
 #include "core/safety/supervisor.hpp"
 #include "firmware/config/daemon_config.hpp"
@@ -83,6 +84,20 @@ struct LidarHealth {
   size_t last_scan_points = 0;
 };
 
+// What the policy task publishes: the companion point q^d and how it was chosen.
+struct CompanionGoal {
+  core::GoalStatus status = core::GoalStatus::kNoPerson;
+  int index = -1;                      // into W
+  int points = 0;                      // n
+  size_t free_points = 0;              // |P|
+  core::Pose2 goal_base;               // q^d in base_link at the time of the choice
+  core::Pose2 goal_odom;               // the same in odom
+  const char* selector = "objective";  // static text: "objective" (or the policy, issue 6)
+};
+// "front", "left", "behind", "right" of the person, from the design point's angle.
+const char* side_of_person(int index, int points);
+core::InteractiveSpaceConfig interactive_space_config(const DaemonConfig& cfg);
+
 core::SupervisorConfig supervisor_config(const DaemonConfig& cfg);
 core::StopLimits stop_limits(const DaemonConfig& cfg);
 amfitrack::AmfitrackConfig amfitrack_config(const DaemonConfig& cfg);
@@ -116,6 +131,7 @@ class Daemon {
   void attach_lidar(std::unique_ptr<hal::UdpReceiver> data);
   [[nodiscard]] const core::LatestValue<LidarHealth>& lidar_health() const { return lidar_health_; }
   [[nodiscard]] const core::SnapshotChannel<core::Costmap>& costmap() const { return costmap_; }
+  [[nodiscard]] const core::LatestValue<CompanionGoal>& goal() const { return goal_; }
   // The executor running the bindings (the supervisor and the report read its statistics).
   void attach(const Executor& executor);
 
@@ -189,6 +205,10 @@ class Daemon {
   RateLimitedLog lidar_warning_;
   core::LatestValue<LidarHealth> lidar_health_;
   core::SnapshotChannel<core::Costmap> costmap_;
+
+  // policy task state
+  core::InteractiveSpace space_;
+  core::LatestValue<CompanionGoal> goal_;
 
   // base (driver owned by the realtime group's thread: base and control tasks)
   std::unique_ptr<hal::CanBus> base_bus_;

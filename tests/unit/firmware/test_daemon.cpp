@@ -103,7 +103,7 @@ TEST(Daemon, WithNoDevicesItHoldsBecauseTheTrackerIsSilentAndSaysSo) {
   const std::string status = d.daemon.status_line();
   EXPECT_EQ(status.rfind("HOLD: tracker silent", 0), 0U) << status;
   EXPECT_NE(status.find("control 100Hz"), std::string::npos) << status;
-  EXPECT_NE(status.find("not yet implemented: control, policy"), std::string::npos) << status;
+  EXPECT_NE(status.find("not yet implemented: control"), std::string::npos) << status;
   const auto sent = sock.receive_containing("STATUS=HOLD: tracker silent", 1s);
   EXPECT_TRUE(sent.has_value());
 }
@@ -524,4 +524,41 @@ TEST(DaemonWithLidar, BuildsTheCostmapAndFeedsTheSupervisor) {
   EXPECT_EQ(map->at(1.0, 0.5), 0);
   EXPECT_EQ(map->at(0.0, 0.0), 0);
   EXPECT_NE(d->daemon.status_line().find("| lidar "), std::string::npos) << d->daemon.status_line();
+}
+
+TEST(DaemonWithTrackerAndLidar, ChoosesACompanionPointAroundThePerson) {
+  auto opened = hal::UdpReceiver::open({"127.0.0.1", 0});
+  ASSERT_TRUE(opened.receiver) << opened.error;
+  RoundRoom room(opened.receiver->port());
+  DaemonWithBase d(
+      [&](Nanos now, DaemonWithBase& w) {
+        if (now == 0ms) person_ahead(w.tracker);  // 1.2 m ahead, 0.3 m right, facing forward
+        room.step(now);
+      },
+      true);
+  d.daemon.attach_lidar(std::move(opened.receiver));
+  d.run_until(1500ms);
+  const auto g = d.daemon.goal().read();
+  ASSERT_TRUE(g);
+  ASSERT_EQ(g->value.status, core::GoalStatus::kOk) << core::to_string(g->value.status);
+  EXPECT_EQ(g->value.points, 64);
+  EXPECT_EQ(g->value.free_points, 64U) << "a 3 m room leaves the whole ellipse free";
+  // On the ellipse around the person: (x - 1.2)^2 / a^2 + (y + 0.3)^2 / b^2 = 1.
+  const double ex = (g->value.goal_base.x_m - 1.2) / 1.0;
+  const double ey = (g->value.goal_base.y_m + 0.3) / 0.7;
+  EXPECT_NEAR(ex * ex + ey * ey, 1.0, 0.02);
+  // The objective (alpha 1, beta 0.5) prefers the side point closest to the robot: behind the
+  // person, toward the robot.
+  EXPECT_LT(g->value.goal_base.x_m, 1.2);
+  EXPECT_NE(d.daemon.status_line().find("| goal objective behind"), std::string::npos)
+      << d.daemon.status_line();
+}
+
+TEST(Daemon, SideOfPersonNamesTheDesignPointsAngle) {
+  EXPECT_STREQ(firmware::side_of_person(0, 64), "front");
+  EXPECT_STREQ(firmware::side_of_person(16, 64), "left");
+  EXPECT_STREQ(firmware::side_of_person(32, 64), "behind");
+  EXPECT_STREQ(firmware::side_of_person(48, 64), "right");
+  EXPECT_STREQ(firmware::side_of_person(63, 64), "front");
+  EXPECT_STREQ(firmware::side_of_person(-1, 64), "-");
 }
