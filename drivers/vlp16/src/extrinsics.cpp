@@ -9,11 +9,10 @@ Extrinsics::Extrinsics(const SensorPose& pose) {
                              Eigen::AngleAxisd(pose.rpy_rad[1], Eigen::Vector3d::UnitY()) *
                              Eigen::AngleAxisd(pose.rpy_rad[0], Eigen::Vector3d::UnitX()))
                                 .toRotationMatrix();
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j)
-      r_[static_cast<size_t>(3 * i + j)] = static_cast<float>(r(i, j));
-    t_[static_cast<size_t>(i)] = static_cast<float>(pose.xyz_m[static_cast<size_t>(i)]);
-  }
+  // Row-major copy (Eigen's default storage is column-major).
+  Eigen::Map<Eigen::Matrix<float, 3, 3, Eigen::RowMajor>>(r_.data()) = r.cast<float>();
+  for (size_t i = 0; i < 3; ++i)
+    t_[i] = static_cast<float>(pose.xyz_m[i]);
 }
 
 void Extrinsics::apply(Point& p) const {
