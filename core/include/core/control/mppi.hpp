@@ -1,0 +1,93 @@
+#pragma once
+// MPPI with a discrete-time CBF cost (paper, section V), on the robot's planar pose in odom.
+//   state (x, y, theta), control (vx, vy, wz) in the body frame, Euler steps of dt:
+//     x += (vx cos th - vy sin th) dt,  y += (vx sin th + vy cos th) dt,  th += wz dt
+//   per step k: tracking (q_k - q^d)^T Q (q_k - q^d), the error expressed in the goal's frame
+//   (e_x along the goal heading, e_y across it, e_theta wrapped); c_collision when the costmap
+//   cost (bilinear) >= R; c_safe max((1 - delta) h_k - h_{k+1}, 0) with h the ellipse barrier
+//   around the person's PREDICTED pose at step k; the control cost lambda u^T Sigma^-1 eps;
+//   a terminal tracking cost at K. Sampled controls are limited to the velocity box and to what
+//   the base's accelerations reach from the previous control.
+//   weights w_m = exp(-(S_m - min S) / lambda); the mean sequence moves by the weighted noise.
+// Warm start: the previous mean shifted by the elapsed time (fractionally: the controller runs
+// every 10 ms while a step is 100 ms), optional smoothing. Noise comes from a pre-generated
+// pool of standard normals (offsets drawn per sample), so it is cheap and reproducible.
+// Samples are evaluated in parallel with OpenMP. NaN anywhere -> zero command and a failure.
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "core/control/dcbf_repair.hpp"
+#include "core/geometry/pose2.hpp"
+#include "core/perception/costmap.hpp"
+#include "core/time.hpp"
+
+namespace core {
+
+struct MppiConfig {
+  int horizon_steps = 100;  // K
+  double step_s = 0.1;      // dt
+  int samples = 2000;       // M
+  double lambda = 1.0;
+  std::array<double, 3> sigma = {0.3, 0.3, 0.5};  // noise std of vx, vy, wz
+  std::array<double, 3> q = {50.0, 10.0, 20.0};   // Q = diag(c_x, c_y, c_theta)
+  double terminal_weight = 2.0;                   // the terminal cost is this times Q's
+  double collision_cost = 1000.0;
+  double cost_threshold = 30.0;  // R
+  double dcbf_delta = 0.5;
+  double c_safe = 5000.0;
+  Ellipse ellipse;
+  TwistLimits limits;
+  double linear_accel_mps2 = 1.5;  // applied to the output command
+  double angular_accel_radps2 = 3.0;
+  bool smooth = true;  // 3-tap smoothing of the updated mean sequence
+  int threads = 2;
+  uint64_t seed = 1;
+};
+
+struct MppiInputs {
+  Pose2 robot;                       // odom
+  Twist current;                     // the last command (for the acceleration limit)
+  Pose2 goal;                        // q^d in odom
+  std::span<const Pose2> person;     // predicted person poses at steps 0..K (odom); may be empty
+  const Costmap* costmap = nullptr;  // may be null (no collision cost)
+  Nanos now{0};
+};
+
+struct MppiOutput {
+  Twist command;    // repaired and limited
+  Twist nominal;    // the first control of the optimised mean, before repair
+  bool ok = false;  // false: numerical failure, command is zero
+  bool repaired = false;
+  bool repair_feasible = true;
+  double min_cost = 0;           // best sample's cost
+  double effective_samples = 0;  // 1 / sum(w^2): how many samples carried the update
+};
+
+class Mppi {
+ public:
+  explicit Mppi(const MppiConfig& config);
+
+  MppiOutput step(const MppiInputs& in);
+  void reset();  // forget the warm start (e.g. after a stop)
+
+  [[nodiscard]] const MppiConfig& config() const { return cfg_; }
+  [[nodiscard]] std::span<const Twist> mean() const { return mean_; }
+
+ private:
+  void shift_mean(Nanos now);
+  double rollout(size_t m, const MppiInputs& in);
+
+  MppiConfig cfg_;
+  std::vector<Twist> mean_;       // K controls
+  std::vector<Twist> scratch_;    // K controls (shift / smoothing)
+  std::vector<float> pool_;       // standard normals
+  std::vector<uint32_t> offset_;  // per sample: where its noise starts in the pool
+  std::vector<double> cost_;      // per sample
+  std::vector<double> weight_;    // per sample
+  uint64_t rng_state_;
+  bool has_time_ = false;
+  Nanos last_{0};
+};
+
+}  // namespace core
