@@ -31,7 +31,7 @@ test: build
 
 bench: deps
 	@cmake --preset release -DCOMPANION_BUILD_BENCH=ON > /dev/null
-	@cmake --build --preset release -j $(JOBS) --target bench_core bench_scheduler bench_tracker bench_lidar
+	@cmake --build --preset release -j $(JOBS) --target bench_core bench_scheduler bench_tracker bench_lidar bench_control
 
 # Coverage-guided fuzzing of the decoders (clang + libFuzzer), FUZZ_SECONDS each, starting from
 # the seed corpora in tests/fuzz/corpus (copied: the repository is not modified).

@@ -86,6 +86,12 @@ class Mppi {
   std::vector<double> cost_;      // per sample
   std::vector<double> weight_;    // per sample
   uint64_t rng_state_;
+  // Prepared once per step for the rollouts.
+  struct PersonFrame {
+    double x, y, c, s;  // predicted person position and heading cos/sin (odom)
+  };
+  std::vector<PersonFrame> person_frames_;  // K + 1 (capacity fixed at construction)
+  double goal_cos_ = 1, goal_sin_ = 0, robot_cos_ = 1, robot_sin_ = 0;
   bool has_time_ = false;
   Nanos last_{0};
 };

@@ -1,0 +1,106 @@
+// One full controller step as on the robot (M = 2000 samples x K = 100 steps: noise, rollouts
+// with all costs, weights, update, smoothing, repair), with 1 and 2 threads; and one policy
+// step's selection (W, P, G). p50 / p99 over repetitions.
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "core/control/mppi.hpp"
+#include "core/perception/costmap.hpp"
+#include "core/perception/voxel_grid.hpp"
+#include "core/planner/interactive_space.hpp"
+
+using namespace std::chrono_literals;
+
+namespace {
+
+double quantile(const std::vector<double>& v, double q) {
+  std::vector<double> s = v;
+  std::sort(s.begin(), s.end());
+  return s[static_cast<size_t>(q * static_cast<double>(s.size() - 1))];
+}
+
+core::Costmap scene() {
+  core::VoxelGridConfig gc;
+  core::VoxelGrid g(gc);
+  g.recentre(0, 0);
+  std::vector<core::Ray> rays;
+  for (double x = -5.5; x <= 5.5; x += 0.02) {
+    rays.push_back({{0, 0, 3.0}, {x, 1.8, 0.5}});   // a corridor wall
+    rays.push_back({{0, 0, 3.0}, {x, -1.8, 0.5}});  // and the other one
+  }
+  g.insert(rays, core::Pose2{30, 30, 0}, std::nullopt, 1s);
+  core::Costmap m;
+  m.build(g, core::CostmapConfig{}, 1s);
+  return m;
+}
+
+// One controller per thread count, kept across repetitions: each repetition times one warm step
+// (as at 100 Hz on the robot), not the construction and the first touch of its buffers.
+struct Warm {
+  std::unique_ptr<core::Mppi> mppi;
+  core::Costmap map;
+  std::vector<core::Pose2> person;
+  core::MppiInputs in;
+  core::Nanos t{0};
+};
+
+Warm& warm(int threads) {
+  static std::array<std::unique_ptr<Warm>, 3> cache;
+  auto& w = cache[static_cast<size_t>(threads)];
+  if (!w) {
+    w = std::make_unique<Warm>();
+    core::MppiConfig cfg;  // K = 100, M = 2000
+    cfg.threads = threads;
+    w->mppi = std::make_unique<core::Mppi>(cfg);
+    w->map = scene();
+    for (int k = 0; k <= 100; ++k)
+      w->person.push_back({1.0 + 0.12 * k, -0.3, 0.0});
+    w->in.goal = core::Pose2{0.6, 0.4, 0.0};
+    w->in.person = w->person;
+    w->in.costmap = &w->map;
+    for (int i = 0; i < 20; ++i) {  // warm up
+      w->in.now = w->t;
+      w->in.current = w->mppi->step(w->in).command;
+      w->t += 10ms;
+    }
+  }
+  return *w;
+}
+
+void BM_MppiStep(benchmark::State& state) {
+  Warm& w = warm(static_cast<int>(state.range(0)));
+  for (auto _ : state) {
+    w.in.now = w.t;
+    const auto out = w.mppi->step(w.in);
+    benchmark::DoNotOptimize(out);
+    w.in.current = out.command;
+    w.t += 10ms;
+  }
+}
+BENCHMARK(BM_MppiStep)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1)
+    ->Repetitions(100)
+    ->ComputeStatistics("p50", [](const std::vector<double>& v) { return quantile(v, 0.5); })
+    ->ComputeStatistics("p99", [](const std::vector<double>& v) { return quantile(v, 0.99); })
+    ->ReportAggregatesOnly(true);
+
+void BM_InteractiveSpaceSelect(benchmark::State& state) {
+  core::InteractiveSpace w(core::InteractiveSpaceConfig{});
+  const core::Costmap map = scene();
+  for (auto _ : state) {
+    w.update(core::Pose2{1.2, -0.3, 0.1}, core::Pose2{0.5, 0.2, 0.3}, map);
+    benchmark::DoNotOptimize(core::select_by_objective(w));
+  }
+}
+BENCHMARK(BM_InteractiveSpaceSelect);
+
+}  // namespace
+
+BENCHMARK_MAIN();
