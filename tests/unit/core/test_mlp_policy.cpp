@@ -170,7 +170,7 @@ TEST(MlpPolicy, LoadsFromAFileAndNamesItInErrors) {
   EXPECT_NE(core::load_policy_file("/nonexistent.policy", kLayout, kPoints, kInput)
                 .error.find("cannot read /nonexistent.policy"),
             std::string::npos);
-  std::remove(path.c_str());
+  (void)std::remove(path.c_str());
 }
 
 }  // namespace

@@ -152,7 +152,7 @@ TEST(Pcap, WriteThenReadRoundTrips) {
     EXPECT_EQ(p->source_ipv4, 0xC0A801C9U);
   }
   EXPECT_FALSE(r->next());
-  std::remove(path.c_str());
+  (void)std::remove(path.c_str());
 }
 
 TEST(Pcap, FrameParsingHandlesVlanCookedFragmentsAndGarbage) {

@@ -28,7 +28,7 @@ inline constexpr int kPatchCells = 16;
 inline constexpr double kPatchResolutionM = 0.25;
 
 constexpr size_t observation_size(size_t points) {
-  return 7 * points + kPatchCells * kPatchCells + 3 + 6 + 3;
+  return 7 * points + static_cast<size_t>(kPatchCells) * kPatchCells + 3 + 6 + 3;
 }
 
 struct ObservationInputs {
