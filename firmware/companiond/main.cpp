@@ -170,6 +170,23 @@ int run(int argc, char** argv) {
   } else if (lidar_uri == "sim") {
     spdlog::warn("lidar: 'sim' needs the simulated world (issue 7); no lidar attached");
   }
+  // The learned selector, when configured: it must load completely, or the daemon does not start.
+  if (!cfg.policy.file.empty()) {
+    const auto n = static_cast<uint32_t>(cfg.interactive_space.points);
+    core::PolicyLoadResult policy =
+        core::load_policy_file(cfg.policy.file, core::kObservationLayout, n,
+                               static_cast<uint32_t>(core::observation_size(n)));
+    if (!policy.policy) {
+      spdlog::critical("{}", policy.error);
+      firmware::shutdown_logging();
+      return 1;
+    }
+    spdlog::info("policy: {} ({} layers), the learned selector chooses q^d", cfg.policy.file,
+                 policy.policy->layers.size());
+    daemon.attach_policy(std::move(*policy.policy));
+  } else {
+    spdlog::info("policy: none configured; the objective argmin chooses q^d");
+  }
   firmware::Executor executor(clock, firmware::group_table(), daemon.bindings());
   daemon.attach(executor);
   executor.start(clock.now() + std::chrono::milliseconds(10), cfg.realtime.enable);

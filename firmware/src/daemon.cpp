@@ -337,6 +337,11 @@ void Daemon::lidar_task(const core::Tick& tick) {
 }
 // ---- policy: the companion point q^d (objective argmin; the learned policy: issue 6) -----------
 
+void Daemon::attach_policy(core::PolicyFile policy) {
+  policy_ = std::make_unique<core::MlpPolicy>(std::move(policy));
+  observation_.assign(core::observation_size(static_cast<size_t>(space_.config().points)), 0.0f);
+}
+
 void Daemon::policy_task(const core::Tick& tick) {
   CompanionGoal g;
   g.points = space_.config().points;
@@ -353,7 +358,34 @@ void Daemon::policy_task(const core::Tick& tick) {
   } else {
     const core::HumanState h = core::human_state(track->value, tick.now, robot_odom, human_config_);
     space_.update(h.pose_base, robot_odom, *map);
-    const core::Selection s = core::select_by_objective(space_);
+    core::Selection s = core::select_by_objective(space_);
+    if (policy_ && s.status == core::GoalStatus::kOk) {
+      // The learned selector: the paper's observation, masked argmax over P.
+      core::ObservationInputs oi;
+      oi.space = &space_;
+      oi.costmap = map.get();
+      oi.robot_odom = robot_odom;
+      if (const auto b = base_health_.read()) {
+        oi.robot_vx_mps = b->value.vx_mps;
+        oi.robot_vy_mps = b->value.vy_mps;
+        oi.robot_wz_radps = b->value.wz_radps;
+      }
+      oi.human = h;
+      oi.previous_action = previous_action_;
+      const auto cs = space_.candidates();
+      std::array<bool, 1024> mask{};
+      for (size_t i = 0; i < cs.size() && i < mask.size(); ++i)
+        mask[i] = cs[i].free;
+      if (core::build_observation(oi, observation_)) {
+        const int a = policy_->select(observation_, std::span<const bool>(mask.data(), cs.size()));
+        if (a >= 0) {
+          s.index = a;
+          s.goal_base = cs[static_cast<size_t>(a)].base;
+          g.selector = "policy";
+        }
+      }
+    }
+    previous_action_ = s.status == core::GoalStatus::kOk ? s.index : -1;
     g.status = s.status;
     g.index = s.index;
     g.free_points = space_.free_count();

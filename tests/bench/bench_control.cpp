@@ -6,12 +6,15 @@
 #include <algorithm>
 #include <array>
 #include <memory>
+#include <random>
 #include <vector>
 
 #include "core/control/mppi.hpp"
 #include "core/perception/costmap.hpp"
 #include "core/perception/voxel_grid.hpp"
 #include "core/planner/interactive_space.hpp"
+#include "core/policy/mlp_policy.hpp"
+#include "core/policy/observation.hpp"
 
 using namespace std::chrono_literals;
 
@@ -100,6 +103,51 @@ void BM_InteractiveSpaceSelect(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_InteractiveSpaceSelect);
+
+// The paper's policy step: W, P, G, the observation (layout 1, 716 floats) and the MLP
+// 716 -> 256 -> 128 -> 64 -> 64 (ReLU), masked argmax. Random weights: the cost is the same.
+void BM_PolicyStep(benchmark::State& state) {
+  const core::Costmap map = scene();
+  core::InteractiveSpace w(core::InteractiveSpaceConfig{});
+  std::mt19937 rng(1);
+  std::normal_distribution<float> n(0.0f, 0.1f);
+  core::PolicyFile p;
+  p.layout_id = core::kObservationLayout;
+  p.points = 64;
+  const auto in = static_cast<Eigen::Index>(core::observation_size(64));
+  p.mean = Eigen::VectorXf::Zero(in);
+  p.stddev = Eigen::VectorXf::Ones(in);
+  Eigen::Index prev = in;
+  for (const int out : {256, 128, 64, 64}) {
+    core::DenseLayer l;
+    l.weights.resize(out, prev);
+    for (Eigen::Index i = 0; i < l.weights.size(); ++i)
+      l.weights.data()[i] = n(rng);
+    l.bias = Eigen::VectorXf::Zero(out);
+    l.activation = out == 64 && prev == 64 ? core::Activation::kNone : core::Activation::kRelu;
+    p.layers.push_back(l);
+    prev = out;
+  }
+  core::MlpPolicy policy(p);
+  std::vector<float> obs(core::observation_size(64));
+  std::array<bool, 64> mask{};
+  core::HumanState h;
+  h.pose_base = core::Pose2{1.2, -0.3, 0.1};
+  for (auto _ : state) {
+    w.update(h.pose_base, core::Pose2{0.5, 0.2, 0.3}, map);
+    const auto cs = w.candidates();
+    for (size_t i = 0; i < cs.size(); ++i)
+      mask[i] = cs[i].free;
+    core::ObservationInputs oi;
+    oi.space = &w;
+    oi.costmap = &map;
+    oi.robot_odom = core::Pose2{0.5, 0.2, 0.3};
+    oi.human = h;
+    core::build_observation(oi, obs);
+    benchmark::DoNotOptimize(policy.select(obs, mask));
+  }
+}
+BENCHMARK(BM_PolicyStep)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 

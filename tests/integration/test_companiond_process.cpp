@@ -136,3 +136,19 @@ TEST(Companiond, WarnsOnceAndRunsWithoutRealTimeWhenNotRequired) {
   EXPECT_EQ(out.find("running WITHOUT real-time guarantees", first + 1), std::string::npos)
       << "one warning, not one per thread";
 }
+
+TEST(Companiond, RefusesAPolicyFileThatDoesNotLoad) {
+  // A policy trained for another interactive-space size: the daemon names the mismatch and stops.
+  const std::string policy = write_temp("wrong-n.policy", "CMPPOL01");  // header cut short
+  const std::string cfg = write_temp("policy.yaml",
+                                     "devices:\n  tracker: none\n  lidar: none\n  base: none\n"
+                                     "policy:\n  file: \"" +
+                                         policy + "\"\n");
+  ChildProcess p({COMPANIOND_PATH, "--config", cfg, "--log-sink", "console"});
+  ASSERT_TRUE(p.started());
+  const auto code = p.wait(10s);
+  ASSERT_TRUE(code.has_value());
+  EXPECT_EQ(*code, 1);
+  EXPECT_NE(p.output().find(policy + ": policy file: truncated header"), std::string::npos)
+      << p.output();
+}

@@ -16,6 +16,8 @@
 #include "core/human/human_ekf.hpp"
 #include "core/perception/costmap.hpp"
 #include "core/planner/interactive_space.hpp"
+#include "core/policy/mlp_policy.hpp"
+#include "core/policy/observation.hpp"
 #include "core/safety/motion_gate.hpp"
 #include "core/safety/supervisor.hpp"
 #include "firmware/config/daemon_config.hpp"
@@ -132,6 +134,8 @@ class Daemon {
   [[nodiscard]] const core::LatestValue<LidarHealth>& lidar_health() const { return lidar_health_; }
   [[nodiscard]] const core::SnapshotChannel<core::Costmap>& costmap() const { return costmap_; }
   [[nodiscard]] const core::LatestValue<CompanionGoal>& goal() const { return goal_; }
+  // The learned selector (optional; without it the objective argmin selects). Before start.
+  void attach_policy(core::PolicyFile policy);
   // The executor running the bindings (the supervisor and the report read its statistics).
   void attach(const Executor& executor);
 
@@ -208,6 +212,9 @@ class Daemon {
 
   // policy task state
   core::InteractiveSpace space_;
+  std::unique_ptr<core::MlpPolicy> policy_;
+  std::vector<float> observation_;
+  int previous_action_ = -1;
   core::LatestValue<CompanionGoal> goal_;
 
   // base (driver owned by the realtime group's thread: base and control tasks)

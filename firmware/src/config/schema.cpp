@@ -603,6 +603,15 @@ std::vector<FieldSpec> build() {
        1.0,
        100.0,
        {}},
+      {"policy.file",
+       "path",
+       "Learned selector (policy file, format in core/include/core/policy/mlp_policy.hpp). Empty: "
+       "the objective argmin selects. A file that does not load (wrong layout, wrong n, bad "
+       "numbers) stops the daemon at start with the reason.",
+       FIELD(policy.file),
+       0,
+       0,
+       {}},
       {"objective.alpha",
        "1/m",
        "alpha: weight of the distance from a candidate to the person in G (not given in the "

@@ -562,3 +562,47 @@ TEST(Daemon, SideOfPersonNamesTheDesignPointsAngle) {
   EXPECT_STREQ(firmware::side_of_person(63, 64), "front");
   EXPECT_STREQ(firmware::side_of_person(-1, 64), "-");
 }
+
+TEST(DaemonWithTrackerAndLidar, ALoadedPolicyChoosesAmongTheFreePoints) {
+  // A tiny policy with the real layout (n = 64, 716 inputs) whose output bias prefers point 40
+  // (to the person's right-behind); the daemon reports it as the active selector.
+  core::PolicyFile p;
+  p.layout_id = core::kObservationLayout;
+  p.points = 64;
+  const auto in = static_cast<Eigen::Index>(core::observation_size(64));
+  p.mean = Eigen::VectorXf::Zero(in);
+  p.stddev = Eigen::VectorXf::Ones(in);
+  core::DenseLayer hidden;
+  hidden.weights = Eigen::MatrixXf::Zero(4, in);
+  hidden.bias = Eigen::VectorXf::Zero(4);
+  hidden.activation = core::Activation::kRelu;
+  core::DenseLayer out;
+  out.weights = Eigen::MatrixXf::Zero(64, 4);
+  out.bias = Eigen::VectorXf::Zero(64);
+  out.bias[40] = 5.0f;
+  p.layers = {hidden, out};
+  // Through the real file format and loader.
+  const auto loaded = core::parse_policy(core::encode_policy(p), core::kObservationLayout, 64,
+                                         static_cast<uint32_t>(in));
+  ASSERT_TRUE(loaded.policy) << loaded.error;
+
+  auto opened = hal::UdpReceiver::open({"127.0.0.1", 0});
+  ASSERT_TRUE(opened.receiver) << opened.error;
+  RoundRoom room(opened.receiver->port());
+  DaemonWithBase d(
+      [&](Nanos now, DaemonWithBase& w) {
+        if (now == 0ms) person_ahead(w.tracker);
+        room.step(now);
+      },
+      true);
+  d.daemon.attach_lidar(std::move(opened.receiver));
+  d.daemon.attach_policy(*loaded.policy);
+  d.run_until(1500ms);
+  const auto g = d.daemon.goal().read();
+  ASSERT_TRUE(g);
+  ASSERT_EQ(g->value.status, core::GoalStatus::kOk);
+  EXPECT_STREQ(g->value.selector, "policy");
+  EXPECT_EQ(g->value.index, 40);
+  EXPECT_NE(d.daemon.status_line().find("| goal policy behind-right"), std::string::npos)
+      << d.daemon.status_line();
+}

@@ -113,6 +113,10 @@ struct DaemonConfig {
     double gamma = 0;
   } objective;
 
+  struct Policy {
+    std::string file;  // empty: the objective argmin selects
+  } policy;
+
   struct Mppi {
     int64_t horizon_steps = 0;
     double step_s = 0;
