@@ -104,6 +104,30 @@ core::InteractiveSpaceConfig interactive_space_config(const DaemonConfig& cfg) {
   return c;
 }
 
+core::MppiConfig mppi_config(const DaemonConfig& cfg) {
+  const auto& m = cfg.mppi;
+  core::MppiConfig c;
+  c.horizon_steps = static_cast<int>(m.horizon_steps);
+  c.step_s = m.step_s;
+  c.samples = static_cast<int>(m.samples);
+  c.lambda = m.lambda;
+  c.sigma = {m.noise_vx_mps, m.noise_vy_mps, m.noise_wz_radps};
+  c.q = {m.q_x, m.q_y, m.q_theta};
+  c.terminal_weight = m.terminal_weight;
+  c.collision_cost = m.collision_cost;
+  c.cost_threshold = cfg.interactive_space.cost_threshold;
+  c.dcbf_delta = cfg.dcbf.delta;
+  c.c_safe = cfg.dcbf.c_safe;
+  c.ellipse = core::Ellipse{cfg.interactive_space.ellipse_a_m, cfg.interactive_space.ellipse_b_m};
+  c.limits =
+      core::TwistLimits{cfg.limits.vx_max_mps, cfg.limits.vy_max_mps, cfg.limits.wz_max_radps};
+  c.linear_accel_mps2 = cfg.limits.linear_accel_max_mps2;
+  c.angular_accel_radps2 = cfg.limits.angular_accel_max_radps2;
+  c.threads = static_cast<int>(m.threads);
+  c.seed = static_cast<uint64_t>(m.seed);
+  return c;
+}
+
 const char* side_of_person(int index, int points) {
   if (index < 0 || points <= 0) return "-";
   // phi = 0 is ahead of the person, counter-clockwise: 90 deg is their left.

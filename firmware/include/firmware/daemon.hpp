@@ -12,6 +12,7 @@
 #include "amfitrack/person_frame.hpp"
 #include "core/channel/latest_value.hpp"
 #include "core/channel/snapshot_channel.hpp"
+#include "core/control/mppi.hpp"
 #include "core/geometry/pose_history.hpp"
 #include "core/human/human_ekf.hpp"
 #include "core/perception/costmap.hpp"
@@ -99,6 +100,7 @@ struct CompanionGoal {
 // "front", "left", "behind", "right" of the person, from the design point's angle.
 const char* side_of_person(int index, int points);
 core::InteractiveSpaceConfig interactive_space_config(const DaemonConfig& cfg);
+core::MppiConfig mppi_config(const DaemonConfig& cfg);
 
 core::SupervisorConfig supervisor_config(const DaemonConfig& cfg);
 core::StopLimits stop_limits(const DaemonConfig& cfg);

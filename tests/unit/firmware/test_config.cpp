@@ -186,3 +186,24 @@ TEST(Config, LidarEndpointAndCostmapBandAreChecked) {
   expect_error(load_config_text("costmap:\n  resolution_m: 0.02\n  z_max_m: 2.0\n", "test.yaml"), 3,
                "costmap.z_max_m", "at most 64 voxels");
 }
+
+#include "firmware/daemon.hpp"
+
+TEST(Config, ControllerParametersComeFromTheConfigurationAsInThePaper) {
+  const auto c = firmware::mppi_config(*firmware::load_default_config().config);
+  EXPECT_EQ(c.horizon_steps, 100);
+  EXPECT_DOUBLE_EQ(c.step_s, 0.1);
+  EXPECT_EQ(c.samples, 2000);
+  EXPECT_DOUBLE_EQ(c.lambda, 1.0);
+  EXPECT_EQ(c.q, (std::array<double, 3>{50.0, 10.0, 20.0}));
+  EXPECT_DOUBLE_EQ(c.collision_cost, 1000.0);
+  EXPECT_DOUBLE_EQ(c.cost_threshold, 30.0);
+  EXPECT_DOUBLE_EQ(c.dcbf_delta, 0.5);
+  EXPECT_DOUBLE_EQ(c.c_safe, 5000.0);
+  EXPECT_DOUBLE_EQ(c.ellipse.a_m, 1.0);
+  EXPECT_DOUBLE_EQ(c.ellipse.b_m, 0.7);
+  EXPECT_DOUBLE_EQ(c.limits.vx, 1.8);
+  const auto w = firmware::interactive_space_config(*firmware::load_default_config().config);
+  EXPECT_EQ(w.points, 64);
+  EXPECT_DOUBLE_EQ(w.cost_threshold, 30.0);
+}

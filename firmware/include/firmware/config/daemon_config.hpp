@@ -129,6 +129,9 @@ struct DaemonConfig {
     double noise_vx_mps = 0;
     double noise_vy_mps = 0;
     double noise_wz_radps = 0;
+    double terminal_weight = 0;
+    int64_t threads = 0;
+    int64_t seed = 0;
   } mppi;
 
   struct Dcbf {
