@@ -33,11 +33,12 @@ Mppi::Mppi(const MppiConfig& config)
       mean_(static_cast<size_t>(config.horizon_steps)),
       scratch_(mean_.size()),
       pool_(kPoolSize),
-      offset_(static_cast<size_t>(config.samples)),
-      cost_(offset_.size()),
-      weight_(offset_.size()),
+      offset_((static_cast<size_t>(config.samples) + kLanes - 1) / kLanes),
+      cost_(offset_.size() * kLanes),
+      weight_(cost_.size()),
       rng_state_(config.seed * 0x9E3779B97F4A7C15ULL + 1) {
   person_frames_.reserve(static_cast<size_t>(config.horizon_steps) + 1);
+  active_.reserve(weight_.size());
   // Standard normals by Box-Muller from the seeded generator: same seed, same pool.
   for (size_t i = 0; i + 1 < pool_.size(); i += 2) {
     const double u1 = (static_cast<double>(next_random(rng_state_) >> 11) + 1.0) * 0x1.0p-53;
@@ -75,88 +76,142 @@ void Mppi::shift_mean(Nanos now) {
   mean_.swap(scratch_);
 }
 
-double Mppi::rollout(size_t m, const MppiInputs& in) {
-  // Hot loop (M x K per step): no trigonometry and no libm calls inside. The heading's cos/sin
-  // advance by the rotation of w dt (a 5th-order series: |w dt| <= 0.2 rad, error < 3e-6), and
-  // the person's predicted frames were prepared once per step (person_frames_).
+// Noise of sample m (in block m / 8, lane m % 8) at step k, dimension d: the 8 lanes of a block
+// read 8 consecutive floats, so a block's rollout loads whole vectors.
+size_t Mppi::noise_index(size_t m, size_t k, size_t d) const {
+  return (offset_[m / kLanes] + (k * 3 + d) * kLanes + m % kLanes) & (kPoolSize - 1);
+}
+
+void Mppi::rollout_block(size_t block, const MppiInputs& in) {
+  // Hot loop (M x K per step), 8 samples at a time in float, structure of arrays: no
+  // trigonometry, no libm calls; the heading's cos/sin advance by the rotation of w dt (a
+  // 5th-order series: |w dt| <= 0.2 rad, error < 3e-6); the person's predicted frames were
+  // prepared once per step. The compiler vectorises the lane loops (SSE/AVX here, NEON on the
+  // Jetson); the costmap lookup is a gather and stays scalar.
+  constexpr size_t L = kLanes;
   const size_t horizon = mean_.size();
-  const double dt = cfg_.step_s;
-  const Pose2& g = in.goal;
-  const double cg = goal_cos_;
-  const double sg = goal_sin_;
-  const double two_pi = 2.0 * std::numbers::pi;
-  auto tracking = [&](double x, double y, double th) {
-    const double dx = x - g.x_m;
-    const double dy = y - g.y_m;
-    const double ex = cg * dx + sg * dy;
-    const double ey = -sg * dx + cg * dy;
-    double et = th - g.theta_rad;
-    et -= two_pi * static_cast<double>(static_cast<int64_t>(et / two_pi + (et >= 0 ? 0.5 : -0.5)));
-    return cfg_.q[0] * ex * ex + cfg_.q[1] * ey * ey + cfg_.q[2] * et * et;
-  };
+  const auto dt = static_cast<float>(cfg_.step_s);
+  const auto gx = static_cast<float>(in.goal.x_m);
+  const auto gy = static_cast<float>(in.goal.y_m);
+  const auto gth = static_cast<float>(in.goal.theta_rad);
+  const auto cg = static_cast<float>(goal_cos_);
+  const auto sg = static_cast<float>(goal_sin_);
+  const auto qx = static_cast<float>(cfg_.q[0]);
+  const auto qy = static_cast<float>(cfg_.q[1]);
+  const auto qt = static_cast<float>(cfg_.q[2]);
+  const float two_pi = 6.283185307f;
+  const float inv_two_pi = 1.0f / two_pi;
+  const auto lvx = static_cast<float>(cfg_.limits.vx);
+  const auto lvy = static_cast<float>(cfg_.limits.vy);
+  const auto lwz = static_cast<float>(cfg_.limits.wz);
+  const auto dv = static_cast<float>(cfg_.linear_accel_mps2 * cfg_.step_s);
+  const auto dw = static_cast<float>(cfg_.angular_accel_radps2 * cfg_.step_s);
+  const auto s0 = static_cast<float>(cfg_.sigma[0]);
+  const auto s1 = static_cast<float>(cfg_.sigma[1]);
+  const auto s2 = static_cast<float>(cfg_.sigma[2]);
+  const auto lam = static_cast<float>(cfg_.lambda);
+  const auto ia = static_cast<float>(1.0 / (cfg_.ellipse.a_m * cfg_.ellipse.a_m));
+  const auto ib = static_cast<float>(1.0 / (cfg_.ellipse.b_m * cfg_.ellipse.b_m));
+  const auto keep = static_cast<float>(1.0 - cfg_.dcbf_delta);
+  const auto c_safe = static_cast<float>(cfg_.c_safe);
   const bool with_person = !person_frames_.empty();
-  const double ia = 1.0 / (cfg_.ellipse.a_m * cfg_.ellipse.a_m);
-  const double ib = 1.0 / (cfg_.ellipse.b_m * cfg_.ellipse.b_m);
-  auto barrier_at = [&](size_t k, double x, double y) {
+  const bool with_map = in.costmap != nullptr;
+  const auto collision = static_cast<float>(cfg_.collision_cost);
+
+  alignas(32) float x[L], y[L], th[L], c[L], s[L], pvx[L], pvy[L], pwz[L], cost[L], h[L];
+  for (size_t j = 0; j < L; ++j) {
+    x[j] = static_cast<float>(in.robot.x_m);
+    y[j] = static_cast<float>(in.robot.y_m);
+    th[j] = static_cast<float>(in.robot.theta_rad);
+    c[j] = static_cast<float>(robot_cos_);
+    s[j] = static_cast<float>(robot_sin_);
+    pvx[j] = static_cast<float>(in.current.vx);
+    pvy[j] = static_cast<float>(in.current.vy);
+    pwz[j] = static_cast<float>(in.current.wz);
+    cost[j] = 0.0f;
+    h[j] = 0.0f;
+  }
+  auto barrier_lanes = [&](size_t k, float* out) {
     const PersonFrame& f = person_frames_[std::min(k, person_frames_.size() - 1)];
-    const double dx = x - f.x;
-    const double dy = y - f.y;
-    const double px = f.c * dx + f.s * dy;
-    const double py = -f.s * dx + f.c * dy;
-    return px * px * ia + py * py * ib - 1.0;
+    const auto fx = static_cast<float>(f.x), fy = static_cast<float>(f.y);
+    const auto fc = static_cast<float>(f.c), fs = static_cast<float>(f.s);
+    for (size_t j = 0; j < L; ++j) {
+      const float dx = x[j] - fx;
+      const float dy = y[j] - fy;
+      const float px = fc * dx + fs * dy;
+      const float py = -fs * dx + fc * dy;
+      out[j] = px * px * ia + py * py * ib - 1.0f;
+    }
   };
-  double x = in.robot.x_m, y = in.robot.y_m, th = in.robot.theta_rad;
-  double c = robot_cos_;
-  double s = robot_sin_;
-  double h = with_person ? barrier_at(0, x, y) : 0.0;
-  double cost = 0.0;
-  size_t idx = offset_[m];
-  Twist prev = in.current;
-  const double dv = cfg_.linear_accel_mps2 * dt;
-  const double dw = cfg_.angular_accel_radps2 * dt;
-  const double inv_s0 = 1.0 / cfg_.sigma[0];
-  const double inv_s1 = 1.0 / cfg_.sigma[1];
-  const double inv_s2 = 1.0 / cfg_.sigma[2];
+  if (with_person) barrier_lanes(0, h);
+  const size_t base = offset_[block];
+  alignas(32) float hn[L];
   for (size_t k = 0; k < horizon; ++k) {
-    const Twist& mu = mean_[k];
-    if (idx + 3 > kPoolSize) idx -= kPoolSize - 3;  // wrap (the pool is long; rare)
-    const double n0 = pool_[idx];
-    const double n1 = pool_[idx + 1];
-    const double n2 = pool_[idx + 2];
-    idx += 3;
-    // The sampled control, within the velocity box and reachable from the previous one with the
-    // base's accelerations (so the rollouts predict what the base will actually do).
-    Twist u = clip(
-        Twist{mu.vx + cfg_.sigma[0] * n0, mu.vy + cfg_.sigma[1] * n1, mu.wz + cfg_.sigma[2] * n2},
-        cfg_.limits);
-    u.vx = std::clamp(u.vx, prev.vx - dv, prev.vx + dv);
-    u.vy = std::clamp(u.vy, prev.vy - dv, prev.vy + dv);
-    u.wz = std::clamp(u.wz, prev.wz - dw, prev.wz + dw);
-    prev = u;
-    // lambda u^T Sigma^-1 eps, eps = sigma n: lambda sum(mu_d n_d / sigma_d)
-    cost += cfg_.lambda * (mu.vx * n0 * inv_s0 + mu.vy * n1 * inv_s1 + mu.wz * n2 * inv_s2);
-    x += (u.vx * c - u.vy * s) * dt;
-    y += (u.vx * s + u.vy * c) * dt;
-    const double a = u.wz * dt;
-    const double a2 = a * a;
-    const double ca = 1.0 - a2 / 2.0 + a2 * a2 / 24.0;
-    const double sa = a * (1.0 - a2 / 6.0 + a2 * a2 / 120.0);
-    const double c_next = c * ca - s * sa;
-    s = s * ca + c * sa;
-    c = c_next;
-    th += a;
-    cost += tracking(x, y, th);
-    if (in.costmap != nullptr && in.costmap->cost(x, y) >= cfg_.cost_threshold) {
-      cost += cfg_.collision_cost;
+    const auto mvx = static_cast<float>(mean_[k].vx);
+    const auto mvy = static_cast<float>(mean_[k].vy);
+    const auto mwz = static_cast<float>(mean_[k].wz);
+    const float* n0 = &pool_[(base + (k * 3 + 0) * L) & (kPoolSize - 1)];
+    const float* n1 = &pool_[(base + (k * 3 + 1) * L) & (kPoolSize - 1)];
+    const float* n2 = &pool_[(base + (k * 3 + 2) * L) & (kPoolSize - 1)];
+    for (size_t j = 0; j < L; ++j) {
+      // The sampled control, in the velocity box and reachable from the previous one with the
+      // base's accelerations (so the rollouts predict what the base will actually do).
+      float vx = std::clamp(mvx + s0 * n0[j], -lvx, lvx);
+      float vy = std::clamp(mvy + s1 * n1[j], -lvy, lvy);
+      float wz = std::clamp(mwz + s2 * n2[j], -lwz, lwz);
+      vx = std::clamp(vx, pvx[j] - dv, pvx[j] + dv);
+      vy = std::clamp(vy, pvy[j] - dv, pvy[j] + dv);
+      wz = std::clamp(wz, pwz[j] - dw, pwz[j] + dw);
+      pvx[j] = vx;
+      pvy[j] = vy;
+      pwz[j] = wz;
+      // lambda u^T Sigma^-1 eps, eps = sigma n: lambda sum(mu_d n_d / sigma_d)
+      cost[j] += lam * (mvx * n0[j] / s0 + mvy * n1[j] / s1 + mwz * n2[j] / s2);
+      x[j] += (vx * c[j] - vy * s[j]) * dt;
+      y[j] += (vx * s[j] + vy * c[j]) * dt;
+      const float a = wz * dt;
+      const float a2 = a * a;
+      const float ca = 1.0f - a2 * 0.5f + a2 * a2 * (1.0f / 24.0f);
+      const float sa = a * (1.0f - a2 * (1.0f / 6.0f) + a2 * a2 * (1.0f / 120.0f));
+      const float cn = c[j] * ca - s[j] * sa;
+      s[j] = s[j] * ca + c[j] * sa;
+      c[j] = cn;
+      th[j] += a;
+      // Tracking, the error in the goal's frame, the angle wrapped to (-pi, pi].
+      const float dx = x[j] - gx;
+      const float dy = y[j] - gy;
+      const float ex = cg * dx + sg * dy;
+      const float ey = -sg * dx + cg * dy;
+      float et = th[j] - gth;
+      const float turns = et * inv_two_pi;
+      et -= two_pi * static_cast<float>(static_cast<int>(turns + (turns >= 0.0f ? 0.5f : -0.5f)));
+      cost[j] += qx * ex * ex + qy * ey * ey + qt * et * et;
+    }
+    if (with_map) {
+      for (size_t j = 0; j < L; ++j) {
+        if (in.costmap->cost(x[j], y[j]) >= cfg_.cost_threshold) cost[j] += collision;
+      }
     }
     if (with_person) {
-      const double h_next = barrier_at(k + 1, x, y);
-      cost += cfg_.c_safe * std::max((1.0 - cfg_.dcbf_delta) * h - h_next, 0.0);
-      h = h_next;
+      barrier_lanes(k + 1, hn);
+      for (size_t j = 0; j < L; ++j) {
+        cost[j] += c_safe * std::max(keep * h[j] - hn[j], 0.0f);
+        h[j] = hn[j];
+      }
     }
   }
-  cost += cfg_.terminal_weight * tracking(x, y, th);
-  return cost;
+  const auto tw = static_cast<float>(cfg_.terminal_weight);
+  for (size_t j = 0; j < L; ++j) {
+    const float dx = x[j] - gx;
+    const float dy = y[j] - gy;
+    const float ex = cg * dx + sg * dy;
+    const float ey = -sg * dx + cg * dy;
+    float et = th[j] - gth;
+    const float turns = et * inv_two_pi;
+    et -= two_pi * static_cast<float>(static_cast<int>(turns + (turns >= 0.0f ? 0.5f : -0.5f)));
+    cost_[block * L + j] =
+        static_cast<double>(cost[j] + tw * (qx * ex * ex + qy * ey * ey + qt * et * et));
+  }
 }
 
 MppiOutput Mppi::step(const MppiInputs& in) {
@@ -174,13 +229,13 @@ MppiOutput Mppi::step(const MppiInputs& in) {
     person_frames_.push_back({p.x_m, p.y_m, std::cos(p.theta_rad), std::sin(p.theta_rad)});
   }
   for (uint32_t& o : offset_) {
-    o = static_cast<uint32_t>(next_random(rng_state_) % kPoolSize);
+    // A block's noise is contiguous per (step, dimension): aligned to whole vectors.
+    o = static_cast<uint32_t>(next_random(rng_state_) % kPoolSize) & ~uint32_t{kLanes - 1};
   }
-  const auto samples = static_cast<int64_t>(offset_.size());
+  const auto blocks = static_cast<int64_t>(offset_.size());
 #pragma omp parallel for num_threads(cfg_.threads) schedule(static)
-  for (int64_t m = 0; m < samples; ++m) {
-    cost_[static_cast<size_t>(m)] = rollout(static_cast<size_t>(m), in);
-  }
+  for (int64_t b = 0; b < blocks; ++b)
+    rollout_block(static_cast<size_t>(b), in);
   double min_cost = std::numeric_limits<double>::infinity();
   for (const double c : cost_)
     min_cost = std::min(min_cost, c);
@@ -198,15 +253,18 @@ MppiOutput Mppi::step(const MppiInputs& in) {
     w /= total;
     sum_sq += w * w;
   }
-  // mean_k += sum_m w_m sigma n_{m,k}
+  // mean_k += sum_m w_m sigma n_{m,k}, over the samples that carry weight (with lambda = 1 and
+  // costs in the thousands, a handful).
+  active_.clear();
+  for (size_t m = 0; m < weight_.size(); ++m) {
+    if (weight_[m] >= 1e-12) active_.push_back(static_cast<uint32_t>(m));
+  }
   for (size_t k = 0; k < mean_.size(); ++k) {
     double d0 = 0, d1 = 0, d2 = 0;
-    for (size_t m = 0; m < weight_.size(); ++m) {
-      if (weight_[m] < 1e-12) continue;
-      const size_t idx = offset_[m] + 3 * k;
-      d0 += weight_[m] * static_cast<double>(pool_[idx % kPoolSize]);
-      d1 += weight_[m] * static_cast<double>(pool_[(idx + 1) % kPoolSize]);
-      d2 += weight_[m] * static_cast<double>(pool_[(idx + 2) % kPoolSize]);
+    for (const uint32_t m : active_) {
+      d0 += weight_[m] * static_cast<double>(pool_[noise_index(m, k, 0)]);
+      d1 += weight_[m] * static_cast<double>(pool_[noise_index(m, k, 1)]);
+      d2 += weight_[m] * static_cast<double>(pool_[noise_index(m, k, 2)]);
     }
     Twist& mu = mean_[k];
     mu = clip(

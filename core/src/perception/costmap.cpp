@@ -125,16 +125,4 @@ uint8_t Costmap::at(double x, double y) const {
   return cell(floor_int(gx), floor_int(gy));
 }
 
-double Costmap::cost(double x, double y) const {
-  const double gx = (x - ox_) / res_ - 0.5;
-  const double gy = (y - oy_) / res_ - 0.5;
-  if (!(std::abs(gx) < 1e9) || !(std::abs(gy) < 1e9)) return kCostLethal;  // NaN or far away
-  const int i = floor_int(gx);
-  const int j = floor_int(gy);
-  const double fx = gx - i;
-  const double fy = gy - j;
-  return (1 - fx) * (1 - fy) * cell(i, j) + fx * (1 - fy) * cell(i + 1, j) +
-         (1 - fx) * fy * cell(i, j + 1) + fx * fy * cell(i + 1, j + 1);
-}
-
 }  // namespace core

@@ -75,16 +75,19 @@ class Mppi {
   [[nodiscard]] std::span<const Twist> mean() const { return mean_; }
 
  private:
+  static constexpr size_t kLanes = 8;  // samples per vectorised block (M is rounded up)
   void shift_mean(Nanos now);
-  double rollout(size_t m, const MppiInputs& in);
+  void rollout_block(size_t block, const MppiInputs& in);
+  [[nodiscard]] size_t noise_index(size_t m, size_t k, size_t d) const;
 
   MppiConfig cfg_;
   std::vector<Twist> mean_;       // K controls
   std::vector<Twist> scratch_;    // K controls (shift / smoothing)
   std::vector<float> pool_;       // standard normals
-  std::vector<uint32_t> offset_;  // per sample: where its noise starts in the pool
+  std::vector<uint32_t> offset_;  // per block of kLanes samples: where its noise starts
   std::vector<double> cost_;      // per sample
   std::vector<double> weight_;    // per sample
+  std::vector<uint32_t> active_;  // samples that carry weight (capacity M: no allocation)
   uint64_t rng_state_;
   // Prepared once per step for the rollouts.
   struct PersonFrame {
