@@ -85,18 +85,30 @@ void Costmap::build(const VoxelGrid& grid, const CostmapConfig& config, Nanos st
           g_[static_cast<size_t>(j)];
     }
   }
-  const double r_in = config.inscribed_radius_m;
-  const double r_out = config.inflation_radius_m;
-  for (size_t c = 0; c < cost_.size(); ++c) {
-    const double d = std::sqrt(static_cast<double>(dist2_[c])) * res_;
-    uint8_t v = 0;
-    if (d <= r_in) {
-      v = kCostLethal;
-    } else if (d <= r_out) {
-      v = static_cast<uint8_t>(
-          std::lround(99.0 * std::exp(-config.cost_scaling_per_m * (d - r_in))));
+  // Squared distances between cell centres are integers: the cost of each is tabulated once per
+  // configuration (no sqrt/exp per cell).
+  const double r_out_cells = config.inflation_radius_m / res_;
+  const auto max_d2 = static_cast<size_t>(std::floor(r_out_cells * r_out_cells));
+  if (lut_.size() != max_d2 + 1 || lut_res_ != res_ ||
+      lut_config_.inscribed_radius_m != config.inscribed_radius_m ||
+      lut_config_.inflation_radius_m != config.inflation_radius_m ||
+      lut_config_.cost_scaling_per_m != config.cost_scaling_per_m) {
+    lut_.resize(max_d2 + 1);
+    for (size_t d2 = 0; d2 <= max_d2; ++d2) {
+      const double d = std::sqrt(static_cast<double>(d2)) * res_;
+      lut_[d2] =
+          d <= config.inscribed_radius_m
+              ? kCostLethal
+              : static_cast<uint8_t>(std::lround(
+                    99.0 * std::exp(-config.cost_scaling_per_m * (d - config.inscribed_radius_m))));
     }
-    cost_[c] = v;
+    lut_config_ = config;
+    lut_res_ = res_;
+  }
+  const auto limit = static_cast<float>(max_d2);
+  for (size_t c = 0; c < cost_.size(); ++c) {
+    const float d2 = dist2_[c];
+    cost_[c] = d2 <= limit ? lut_[static_cast<size_t>(d2 + 0.5f)] : 0;
   }
 }
 

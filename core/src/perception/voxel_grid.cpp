@@ -26,8 +26,9 @@ uint16_t stamp_units(Nanos now) {
 VoxelGrid::VoxelGrid(const VoxelGridConfig& config)
     : cfg_(config),
       res_(config.resolution_m),
-      n_((std::max(8, static_cast<int>(std::lround(config.size_xy_m / config.resolution_m))) + 7) /
-         8 * 8),
+      n_((std::max(kBlock, static_cast<int>(std::lround(config.size_xy_m / config.resolution_m))) +
+          kBlock - 1) /
+         kBlock * kBlock),
       nz_(std::clamp(
           static_cast<int>(std::ceil((config.z_max_m - config.z_min_m) / config.resolution_m)), 1,
           64)),
@@ -159,10 +160,12 @@ void VoxelGrid::clear_ray(const Ray& r, int64_t end_cx, int64_t end_cy, int end_
   double t = t0;
   while (t < t1) {
     const auto col = static_cast<size_t>(sj * n_ + si);
-    if (block_count_[static_cast<size_t>((sj >> 3) * blocks_per_row + (si >> 3))] == 0) {
-      // Nothing to clear in this 8 x 8 block: continue from where the ray leaves it.
-      const auto bx = static_cast<double>(cx >> 3);  // arithmetic shift: floor(cx / kBlock)
-      const auto by = static_cast<double>(cy >> 3);
+    if (block_count_[static_cast<size_t>((sj >> kBlockShift) * blocks_per_row +
+                                         (si >> kBlockShift))] == 0) {
+      // Nothing to clear in this block: continue from where the ray leaves it.
+      const auto bx =
+          static_cast<double>(cx >> kBlockShift);  // arithmetic shift: floor(cx / kBlock)
+      const auto by = static_cast<double>(cy >> kBlockShift);
       const double tx = adx < 1e-12 ? kNoStep : ((bx + (sx > 0 ? 1 : 0)) * block_m - x0) * inv_dx;
       const double ty = ady < 1e-12 ? kNoStep : ((by + (sy > 0 ? 1 : 0)) * block_m - y0) * inv_dy;
       const double t_exit = std::min(tx, ty);

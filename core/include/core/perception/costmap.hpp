@@ -74,6 +74,10 @@ class Costmap {
   std::vector<float> dist2_;
   std::vector<float> f_, g_, z_;
   std::vector<int> v_;
+  // cost by squared distance in cells, for the configuration it was made for
+  std::vector<uint8_t> lut_;
+  CostmapConfig lut_config_;
+  double lut_res_ = 0;
 };
 
 }  // namespace core

@@ -11,7 +11,7 @@
 //   - decay: a voxel not re-marked for `decay_s` is freed.
 // Each column of the window holds a 64-bit occupancy mask (so the height band is at most 64
 // voxels) and a per-voxel marking time. Memory is fixed at construction; nothing allocates after.
-// The window side is rounded up to a multiple of 8 cells (rays skip empty 8 x 8 blocks).
+// The window side is rounded up to a multiple of 16 cells (rays skip empty 16 x 16 blocks).
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -99,7 +99,8 @@ class VoxelGrid {
   std::vector<uint64_t> mask_;   // per column
   std::vector<uint16_t> stamp_;  // per voxel: marking time, 10 ms units (wraps at 655 s)
   // Non-empty columns per block of kBlock x kBlock columns: rays skip empty blocks whole.
-  static constexpr int kBlock = 8;  // the ray loop divides by shifting 3 bits
+  static constexpr int kBlock = 16;  // the ray loop divides by shifting kBlockShift bits
+  static constexpr int kBlockShift = 4;
   std::vector<uint16_t> block_count_;
   // End voxels already traced in this scan (open addressing, cleared per insert): rays that end
   // in the same voxel cross the same voxels to within a fraction of one, so one is cast.
