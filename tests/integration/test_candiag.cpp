@@ -14,18 +14,12 @@ using test_support::ChildProcess;
 
 namespace {
 
-struct Result {
-  int code = -1;
-  std::string out;
-};
+using Result = test_support::ToolResult;
 
 Result candiag(std::vector<std::string> args) {
-  args.insert(args.begin(), CANDIAG_PATH);
-  ChildProcess p(args);
-  EXPECT_TRUE(p.started());
-  const auto code = p.wait(30s);
-  EXPECT_TRUE(code.has_value()) << "companion-candiag did not finish";
-  return {code.value_or(-1), p.output()};
+  Result r = test_support::run_tool(CANDIAG_PATH, std::move(args), 30s);
+  EXPECT_NE(r.code, -1) << "companion-candiag did not finish";
+  return r;
 }
 
 }  // namespace

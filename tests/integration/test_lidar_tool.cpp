@@ -20,18 +20,12 @@ using test_support::ChildProcess;
 
 namespace {
 
-struct Result {
-  int code = -1;
-  std::string out;
-};
+using Result = test_support::ToolResult;
 
 Result lidar_tool(std::vector<std::string> args) {
-  args.insert(args.begin(), LIDAR_TOOL_PATH);
-  ChildProcess p(args);
-  EXPECT_TRUE(p.started());
-  const auto code = p.wait(60s);
-  EXPECT_TRUE(code.has_value()) << "companion-lidar did not finish";
-  return {code.value_or(-1), p.output()};
+  Result r = test_support::run_tool(LIDAR_TOOL_PATH, std::move(args), 60s);
+  EXPECT_NE(r.code, -1) << "companion-lidar did not finish";
+  return r;
 }
 
 size_t count_lines_with(const std::string& text, const std::string& what) {

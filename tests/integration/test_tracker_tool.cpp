@@ -19,18 +19,12 @@ using test_support::ChildProcess;
 
 namespace {
 
-struct Result {
-  int code = -1;
-  std::string out;
-};
+using Result = test_support::ToolResult;
 
 Result tracker_tool(std::vector<std::string> args) {
-  args.insert(args.begin(), TRACKER_TOOL_PATH);
-  ChildProcess p(args);
-  EXPECT_TRUE(p.started());
-  const auto code = p.wait(30s);
-  EXPECT_TRUE(code.has_value()) << "companion-tracker did not finish";
-  return {code.value_or(-1), p.output()};
+  Result r = test_support::run_tool(TRACKER_TOOL_PATH, std::move(args), 30s);
+  EXPECT_NE(r.code, -1) << "companion-tracker did not finish";
+  return r;
 }
 
 std::string temp_path(const char* name) {

@@ -83,4 +83,18 @@ class ChildProcess {
   std::string out_;
 };
 
+// Runs a tool to completion: its exit code (-1 if it did not finish in `timeout`) and output.
+struct ToolResult {
+  int code = -1;
+  std::string out;
+};
+inline ToolResult run_tool(const std::string& path, std::vector<std::string> args,
+                           std::chrono::milliseconds timeout = std::chrono::seconds(30)) {
+  args.insert(args.begin(), path);
+  ChildProcess p(args);
+  if (!p.started()) return {};
+  const auto code = p.wait(timeout);
+  return {code.value_or(-1), p.output()};
+}
+
 }  // namespace test_support

@@ -118,6 +118,17 @@ void Mppi::rollout_block(size_t block, const MppiInputs& in) {
   const bool with_map = in.costmap != nullptr;
   const auto collision = static_cast<float>(cfg_.collision_cost);
 
+  // Tracking: the error in the goal's frame, the angle wrapped to (-pi, pi].
+  auto tracking = [&](float px, float py, float pth) {
+    const float dx = px - gx;
+    const float dy = py - gy;
+    const float ex = cg * dx + sg * dy;
+    const float ey = -sg * dx + cg * dy;
+    float et = pth - gth;
+    const float turns = et * inv_two_pi;
+    et -= two_pi * static_cast<float>(static_cast<int>(turns + (turns >= 0.0f ? 0.5f : -0.5f)));
+    return qx * ex * ex + qy * ey * ey + qt * et * et;
+  };
   alignas(32) float x[L], y[L], th[L], c[L], s[L], pvx[L], pvy[L], pwz[L], cost[L], h[L];
   for (size_t j = 0; j < L; ++j) {
     x[j] = static_cast<float>(in.robot.x_m);
@@ -177,15 +188,7 @@ void Mppi::rollout_block(size_t block, const MppiInputs& in) {
       s[j] = s[j] * ca + c[j] * sa;
       c[j] = cn;
       th[j] += a;
-      // Tracking, the error in the goal's frame, the angle wrapped to (-pi, pi].
-      const float dx = x[j] - gx;
-      const float dy = y[j] - gy;
-      const float ex = cg * dx + sg * dy;
-      const float ey = -sg * dx + cg * dy;
-      float et = th[j] - gth;
-      const float turns = et * inv_two_pi;
-      et -= two_pi * static_cast<float>(static_cast<int>(turns + (turns >= 0.0f ? 0.5f : -0.5f)));
-      cost[j] += qx * ex * ex + qy * ey * ey + qt * et * et;
+      cost[j] += tracking(x[j], y[j], th[j]);
     }
     if (with_map) {
       for (size_t j = 0; j < L; ++j) {
@@ -202,15 +205,7 @@ void Mppi::rollout_block(size_t block, const MppiInputs& in) {
   }
   const auto tw = static_cast<float>(cfg_.terminal_weight);
   for (size_t j = 0; j < L; ++j) {
-    const float dx = x[j] - gx;
-    const float dy = y[j] - gy;
-    const float ex = cg * dx + sg * dy;
-    const float ey = -sg * dx + cg * dy;
-    float et = th[j] - gth;
-    const float turns = et * inv_two_pi;
-    et -= two_pi * static_cast<float>(static_cast<int>(turns + (turns >= 0.0f ? 0.5f : -0.5f)));
-    cost_[block * L + j] =
-        static_cast<double>(cost[j] + tw * (qx * ex * ex + qy * ey * ey + qt * et * et));
+    cost_[block * L + j] = static_cast<double>(cost[j] + tw * tracking(x[j], y[j], th[j]));
   }
 }
 
