@@ -88,7 +88,7 @@ void Mppi::rollout_block(size_t block, const MppiInputs& in) {
   // 5th-order series: |w dt| <= 0.2 rad, error < 3e-6); the person's predicted frames were
   // prepared once per step. The compiler vectorises the lane loops (SSE/AVX here, NEON on the
   // Jetson); the costmap lookup is a gather and stays scalar.
-  constexpr size_t L = kLanes;
+  constexpr size_t kL = kLanes;
   const size_t horizon = mean_.size();
   const auto dt = static_cast<float>(cfg_.step_s);
   const auto gx = static_cast<float>(in.goal.x_m);
@@ -129,8 +129,8 @@ void Mppi::rollout_block(size_t block, const MppiInputs& in) {
     et -= two_pi * static_cast<float>(static_cast<int>(turns + (turns >= 0.0f ? 0.5f : -0.5f)));
     return qx * ex * ex + qy * ey * ey + qt * et * et;
   };
-  alignas(32) float x[L], y[L], th[L], c[L], s[L], pvx[L], pvy[L], pwz[L], cost[L], h[L];
-  for (size_t j = 0; j < L; ++j) {
+  alignas(32) float x[kL], y[kL], th[kL], c[kL], s[kL], pvx[kL], pvy[kL], pwz[kL], cost[kL], h[kL];
+  for (size_t j = 0; j < kL; ++j) {
     x[j] = static_cast<float>(in.robot.x_m);
     y[j] = static_cast<float>(in.robot.y_m);
     th[j] = static_cast<float>(in.robot.theta_rad);
@@ -146,7 +146,7 @@ void Mppi::rollout_block(size_t block, const MppiInputs& in) {
     const PersonFrame& f = person_frames_[std::min(k, person_frames_.size() - 1)];
     const auto fx = static_cast<float>(f.x), fy = static_cast<float>(f.y);
     const auto fc = static_cast<float>(f.c), fs = static_cast<float>(f.s);
-    for (size_t j = 0; j < L; ++j) {
+    for (size_t j = 0; j < kL; ++j) {
       const float dx = x[j] - fx;
       const float dy = y[j] - fy;
       const float px = fc * dx + fs * dy;
@@ -156,15 +156,15 @@ void Mppi::rollout_block(size_t block, const MppiInputs& in) {
   };
   if (with_person) barrier_lanes(0, h);
   const size_t base = offset_[block];
-  alignas(32) float hn[L];
+  alignas(32) float hn[kL];
   for (size_t k = 0; k < horizon; ++k) {
     const auto mvx = static_cast<float>(mean_[k].vx);
     const auto mvy = static_cast<float>(mean_[k].vy);
     const auto mwz = static_cast<float>(mean_[k].wz);
-    const float* n0 = &pool_[(base + (k * 3 + 0) * L) & (kPoolSize - 1)];
-    const float* n1 = &pool_[(base + (k * 3 + 1) * L) & (kPoolSize - 1)];
-    const float* n2 = &pool_[(base + (k * 3 + 2) * L) & (kPoolSize - 1)];
-    for (size_t j = 0; j < L; ++j) {
+    const float* n0 = &pool_[(base + (k * 3 + 0) * kL) & (kPoolSize - 1)];
+    const float* n1 = &pool_[(base + (k * 3 + 1) * kL) & (kPoolSize - 1)];
+    const float* n2 = &pool_[(base + (k * 3 + 2) * kL) & (kPoolSize - 1)];
+    for (size_t j = 0; j < kL; ++j) {
       // The sampled control, in the velocity box and reachable from the previous one with the
       // base's accelerations (so the rollouts predict what the base will actually do).
       float vx = std::clamp(mvx + s0 * n0[j], -lvx, lvx);
@@ -191,21 +191,21 @@ void Mppi::rollout_block(size_t block, const MppiInputs& in) {
       cost[j] += tracking(x[j], y[j], th[j]);
     }
     if (with_map) {
-      for (size_t j = 0; j < L; ++j) {
+      for (size_t j = 0; j < kL; ++j) {
         if (in.costmap->cost(x[j], y[j]) >= cfg_.cost_threshold) cost[j] += collision;
       }
     }
     if (with_person) {
       barrier_lanes(k + 1, hn);
-      for (size_t j = 0; j < L; ++j) {
+      for (size_t j = 0; j < kL; ++j) {
         cost[j] += c_safe * std::max(keep * h[j] - hn[j], 0.0f);
         h[j] = hn[j];
       }
     }
   }
   const auto tw = static_cast<float>(cfg_.terminal_weight);
-  for (size_t j = 0; j < L; ++j) {
-    cost_[block * L + j] = static_cast<double>(cost[j] + tw * tracking(x[j], y[j], th[j]));
+  for (size_t j = 0; j < kL; ++j) {
+    cost_[block * kL + j] = static_cast<double>(cost[j] + tw * tracking(x[j], y[j], th[j]));
   }
 }
 
