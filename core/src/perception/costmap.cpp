@@ -108,9 +108,8 @@ void Costmap::build(const VoxelGrid& grid, const CostmapConfig& config, Nanos st
   const auto limit = static_cast<float>(max_d2);
   for (size_t c = 0; c < cost_.size(); ++c) {
     const float d2 = dist2_[c];
-    // d2 holds an exact integer (a sum of squared cell offsets): truncation after +0.5 is exact.
-    cost_[c] = d2 <= limit ? lut_[static_cast<size_t>(d2 + 0.5f)]
-                           : 0;  // NOLINT(bugprone-incorrect-roundings)
+    // d2 holds an exact integer (a sum of squared cell offsets): truncation is exact.
+    cost_[c] = d2 <= limit ? lut_[static_cast<size_t>(d2)] : 0;
   }
 }
 
