@@ -76,7 +76,8 @@ void BM_PersonFrame(benchmark::State& state) {
   e.source_rpy_rad = {0, 0, 3.14159};
   const am::PersonFrame f(e);
   const auto m = sample(1);
-  for (auto _ : state) benchmark::DoNotOptimize(f.to_base(m));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(f.to_base(m));
 }
 BENCHMARK(BM_PersonFrame);
 

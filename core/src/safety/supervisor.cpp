@@ -14,7 +14,6 @@ double age_ms(Nanos stamp, Nanos now) {
   return stamp == kNever ? std::numeric_limits<double>::infinity() : to_ms(now - stamp);
 }
 
-
 }  // namespace
 
 Supervisor::Supervisor(const SupervisorConfig& config) : config_(config) {
