@@ -544,10 +544,5 @@ int run(int argc, char** argv) {
 }
 
 int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    complain("companion-candiag: %s\n", e.what());
-    return 3;
-  }
+  return firmware::tool::main_guarded("companion-candiag", run, argc, argv);
 }

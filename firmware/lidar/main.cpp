@@ -422,10 +422,5 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    complain("companion-lidar: %s\n", e.what());
-    return 3;
-  }
+  return firmware::tool::main_guarded("companion-lidar", run, argc, argv);
 }

@@ -195,10 +195,12 @@ bool Daemon::shutdown_complete() const {
 void Daemon::attach_tracker(std::unique_ptr<amfitrack::PacketLink> link) {
   tracker_link_ = std::move(link);
   tracker_ = std::make_unique<amfitrack::Amfitrack>(*tracker_link_, amfitrack_config(cfg_));
+  // Resolved once here, not per run: a reconnecting link also reports why it is down.
+  tracker_reconnecting_ = dynamic_cast<const amfitrack::ReconnectingLink*>(tracker_link_.get());
 }
 
 void Daemon::tracker_link_events(Nanos now) {
-  const auto* rl = dynamic_cast<const amfitrack::ReconnectingLink*>(tracker_link_.get());
+  const amfitrack::ReconnectingLink* rl = tracker_reconnecting_;
   const bool up = !tracker_link_->failed();
   if (up != tracker_link_was_up_) {
     if (up) {
@@ -225,11 +227,10 @@ void Daemon::tracker_task(const core::Tick& tick) {
   if (const auto b = base_health_.read(); b && b->value.odom_stamp != core::kNever) {
     odom_history_.add(b->value.odom, b->value.odom_stamp);
   }
-  TrackerHealth h;
   for (const amfitrack::StampedMeasurement& sm : tracker_->new_measurements()) {
     const auto person = person_frame_.to_base(sm.m);
     if (!person) continue;
-    h.person_distance_m = person->distance_m;
+    person_distance_m_ = person->distance_m;
     // A frame the gate calls BAD (no tracking, distorted field) is not a measurement.
     if (sm.confidence == amfitrack::Confidence::kBad) continue;
     core::Pose2 base_in_odom;
@@ -248,12 +249,9 @@ void Daemon::tracker_task(const core::Tick& tick) {
   }
 
   const amfitrack::GateOutput gate = tracker_->confidence(tick.now);
-  if (const auto& latest = tracker_->latest()) {
-    h.frame_stamp = latest->stamp;
-    if (std::isnan(h.person_distance_m)) {
-      if (const auto p = person_frame_.to_base(latest->m)) h.person_distance_m = p->distance_m;
-    }
-  }
+  TrackerHealth h;
+  if (const auto& latest = tracker_->latest()) h.frame_stamp = latest->stamp;
+  h.person_distance_m = person_distance_m_;  // of the newest frame with a valid pose
   h.confidence = to_tracker_confidence(gate.confidence);
   h.gate_reason = gate.reason;
   h.quality = gate.quality;
@@ -349,7 +347,6 @@ void Daemon::lidar_task(const core::Tick& tick) {
     ++lidar_state_.scans;
     lidar_state_.costmap_stamp = m->stamp();
     lidar_state_.obstacle_cells = m->obstacle_cells();
-    lidar_state_.last_scan_points = lidar_->last_scan().points;
     if (core::Costmap* out = costmap_.begin_write()) {
       out->copy_cells_from(*m);  // into a spare buffer (allocates only the first time)
       costmap_.publish();
@@ -380,7 +377,10 @@ void Daemon::policy_task(const core::Tick& tick) {
   } else if (!map) {
     g.status = core::GoalStatus::kNoCostmap;
   } else {
-    const core::HumanState h = core::human_state(track->value, tick.now, robot_odom, human_config_);
+    const auto th = tracker_health_.read();
+    const core::HumanState h =
+        core::human_state(track->value, tick.now, robot_odom, human_config_,
+                          th ? th->value.confidence : core::TrackerConfidence::kUnknown);
     space_.update(h.pose_base, robot_odom, *map);
     core::Selection s = core::select_by_objective(space_);
     if (policy_ && s.status == core::GoalStatus::kOk) {

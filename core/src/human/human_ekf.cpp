@@ -199,8 +199,9 @@ UpdateResult HumanEkf::update_yaw_rate(double yaw_rate_radps, Nanos stamp) {
 }
 
 HumanState human_state(const HumanTrack& track, Nanos t, const Pose2& base_in_odom,
-                       const HumanEkfConfig& config) {
+                       const HumanEkfConfig& config, TrackerConfidence confidence) {
   HumanState h;
+  h.confidence = confidence;
   if (!track.valid) return h;
   const HumanTrack p = predict_track(track, t, config);
   h.valid = true;
@@ -214,6 +215,10 @@ HumanState human_state(const HumanTrack& track, Nanos t, const Pose2& base_in_od
                                                            Eigen::EigenvaluesOnly);
   h.position_sigma_m = std::sqrt(std::max(0.0, eig.eigenvalues()(1)));
   h.heading_sigma_rad = std::sqrt(std::max(0.0, p.covariance()(2, 2)));
+  // Row-major copy (the track's storage is column-major).
+  Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(h.pose_covariance_odom.data()) =
+      p.covariance().topLeftCorner<3, 3>();
+
   h.age = t - track.last_update;
   return h;
 }

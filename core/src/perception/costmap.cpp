@@ -123,14 +123,6 @@ void Costmap::copy_cells_from(const Costmap& other) {
   cost_.assign(other.cost_.begin(), other.cost_.end());  // no allocation once sized
 }
 
-namespace {
-// floor() without the libm call: the controller looks up the costmap 200 000 times per step.
-inline int floor_int(double v) {
-  const auto i = static_cast<int>(v);
-  return i - static_cast<int>(v < static_cast<double>(i));
-}
-}  // namespace
-
 uint8_t Costmap::at(double x, double y) const {
   const double gx = (x - ox_) / res_;
   const double gy = (y - oy_) / res_;

@@ -13,28 +13,17 @@ Eigen::Matrix3d rpy(const std::array<double, 3>& a) {
       .toRotationMatrix();
 }
 
-using RowMajor3d = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
-
-void store(const Eigen::Matrix3d& m, std::array<double, 9>& out) {
-  Eigen::Map<RowMajor3d>(out.data()) = m;
-}
-
-Eigen::Matrix3d load(const std::array<double, 9>& a) {
-  return Eigen::Map<const RowMajor3d>(a.data());
-}
-
 // Below this length of the floor projection of the body x axis (i.e. within ~8 degrees of
 // vertical) the heading is undefined.
 constexpr double kMinHorizontal = 0.14;
 
 }  // namespace
 
-PersonFrame::PersonFrame(const TrackerExtrinsics& e) {
-  store(rpy(e.source_rpy_rad), r_base_source_);
-  t_base_source_ = e.source_xyz_m;
-  // R_body_sensor = rpy(sensor_in_body); body axes in sensor coordinates = its transpose.
-  store(rpy(e.sensor_in_body_rpy_rad).transpose(), r_sensor_body_);
-}
+PersonFrame::PersonFrame(const TrackerExtrinsics& e)
+    : r_base_source_(rpy(e.source_rpy_rad)),
+      t_base_source_(e.source_xyz_m[0], e.source_xyz_m[1], e.source_xyz_m[2]),
+      // R_body_sensor = rpy(sensor_in_body); body axes in sensor coordinates = its transpose.
+      r_sensor_body_(rpy(e.sensor_in_body_rpy_rad).transpose()) {}
 
 std::optional<PersonInBase> PersonFrame::to_base(const SensorMeasurement& m) const {
   const auto& q = m.quaternion_xyzw;
@@ -43,11 +32,9 @@ std::optional<PersonInBase> PersonFrame::to_base(const SensorMeasurement& m) con
   if (!p_source.allFinite() || !std::isfinite(norm) || norm < 0.5) return std::nullopt;
   const Eigen::Quaterniond q_source_sensor(q[3] / norm, q[0] / norm, q[1] / norm, q[2] / norm);
 
-  const Eigen::Matrix3d r_base_source = load(r_base_source_);
-  const Eigen::Vector3d t(t_base_source_[0], t_base_source_[1], t_base_source_[2]);
-  const Eigen::Vector3d p_base = r_base_source * p_source + t;
-  const Eigen::Matrix3d r_base_sensor = r_base_source * q_source_sensor.toRotationMatrix();
-  const Eigen::Matrix3d r_base_body = r_base_sensor * load(r_sensor_body_);
+  const Eigen::Vector3d p_base = r_base_source_ * p_source + t_base_source_;
+  const Eigen::Matrix3d r_base_sensor = r_base_source_ * q_source_sensor.toRotationMatrix();
+  const Eigen::Matrix3d r_base_body = r_base_sensor * r_sensor_body_;
 
   PersonInBase out;
   out.x_m = p_base.x();

@@ -84,7 +84,6 @@ struct LidarHealth {
   uint64_t kernel_drops = 0;
   uint64_t scans = 0;
   size_t obstacle_cells = 0;
-  size_t last_scan_points = 0;
 };
 
 // What the policy task publishes: the companion point q^d and how it was chosen.
@@ -193,6 +192,8 @@ class Daemon {
   void tracker_link_events(core::Nanos now);
   std::unique_ptr<amfitrack::PacketLink> tracker_link_;
   std::unique_ptr<amfitrack::Amfitrack> tracker_;
+  const amfitrack::ReconnectingLink* tracker_reconnecting_ = nullptr;  // tracker_link_, if so
+  double person_distance_m_ = std::numeric_limits<double>::quiet_NaN();
   amfitrack::PersonFrame person_frame_;
   core::HumanEkfConfig human_config_;
   core::HumanEkf human_ekf_;

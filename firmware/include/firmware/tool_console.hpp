@@ -5,6 +5,7 @@
 #include <csignal>
 #include <cstdarg>
 #include <cstdio>
+#include <exception>
 
 namespace firmware::tool {
 
@@ -31,6 +32,16 @@ inline void on_signal(int /*sig*/) {
 inline void catch_interrupts() {
   (void)std::signal(SIGINT, on_signal);
   (void)std::signal(SIGTERM, on_signal);
+}
+
+// A tool's main: runs `run`, and turns an escaping exception into a message and exit code 3.
+inline int main_guarded(const char* tool, int (*run)(int, char**), int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    complain("%s: %s\n", tool, e.what());
+    return 3;
+  }
 }
 
 }  // namespace firmware::tool

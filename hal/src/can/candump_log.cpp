@@ -96,32 +96,4 @@ std::string format_candump_line(const CandumpRecord& rec, bool nine_digits) {
   return log_line_prefix(rec.sec, rec.nsec, rec.iface, nine_digits) + to_cansend(rec.frame);
 }
 
-CandumpReader::CandumpReader(const std::string& path) : in_(path) {}
-
-std::optional<CandumpRecord> CandumpReader::next() {
-  std::string line;
-  while (std::getline(in_, line)) {
-    ++line_;
-    CandumpRecord rec;
-    std::string error;
-    switch (parse_candump_line(line, rec, error)) {
-      case CandumpParse::kRecord:
-        return rec;
-      case CandumpParse::kIgnored:
-        break;
-      case CandumpParse::kMalformed:
-        ++malformed_;
-        last_error_ = "line " + std::to_string(line_) + ": " + error;
-        break;
-    }
-  }
-  return std::nullopt;
-}
-
-CandumpWriter::CandumpWriter(const std::string& path) : out_(path) {}
-
-void CandumpWriter::write(const CandumpRecord& rec) {
-  out_ << format_candump_line(rec) << '\n';
-}
-
 }  // namespace hal

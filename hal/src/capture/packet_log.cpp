@@ -43,32 +43,4 @@ std::string format_packet_line(const PacketRecord& rec, bool nine_digits) {
   return line;
 }
 
-PacketLogReader::PacketLogReader(const std::string& path) : in_(path) {}
-
-std::optional<PacketRecord> PacketLogReader::next() {
-  std::string line;
-  while (std::getline(in_, line)) {
-    ++line_;
-    PacketRecord rec;
-    std::string error;
-    switch (parse_packet_line(line, rec, error)) {
-      case LogLineParse::kRecord:
-        return rec;
-      case LogLineParse::kIgnored:
-        break;
-      case LogLineParse::kMalformed:
-        ++malformed_;
-        last_error_ = "line " + std::to_string(line_) + ": " + error;
-        break;
-    }
-  }
-  return std::nullopt;
-}
-
-PacketLogWriter::PacketLogWriter(const std::string& path) : out_(path) {}
-
-void PacketLogWriter::write(const PacketRecord& rec) {
-  out_ << format_packet_line(rec) << '\n';
-}
-
 }  // namespace hal

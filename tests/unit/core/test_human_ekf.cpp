@@ -239,6 +239,16 @@ TEST(HumanEkf, PredictsToQueryTimesAndIntoTheRobotFrame) {
   EXPECT_NEAR(h.velocity_base.y_m, -1.0, 1e-12);
   EXPECT_EQ(h.age, 1s);
   EXPECT_GT(h.position_sigma_m, 0.1) << "uncertainty grows with the prediction";
+  // The covariance at the query time: the prediction's (larger than the track's 0.01).
+  EXPECT_GT(h.pose_covariance_odom[0], 0.01);
+  EXPECT_DOUBLE_EQ(h.pose_covariance_odom[1], h.pose_covariance_odom[3]) << "symmetric";
+  EXPECT_NEAR(h.position_sigma_m * h.position_sigma_m,
+              std::max(h.pose_covariance_odom[0], h.pose_covariance_odom[4]), 1e-9)
+      << "x and y are uncorrelated here";
+  EXPECT_EQ(h.confidence, core::TrackerConfidence::kUnknown);
+  EXPECT_EQ(
+      core::human_state(track, 2s, base_in_odom, cfg, core::TrackerConfidence::kGood).confidence,
+      core::TrackerConfidence::kGood);
 }
 
 }  // namespace

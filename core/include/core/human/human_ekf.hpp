@@ -12,6 +12,7 @@
 #include <span>
 
 #include "core/geometry/pose2.hpp"
+#include "core/safety/supervisor.hpp"  // TrackerConfidence
 #include "core/time.hpp"
 
 namespace core {
@@ -102,13 +103,18 @@ struct HumanState {
   Pose2 pose_odom;
   Point2 velocity_odom;  // m/s
   double yaw_rate_radps = 0;
-  Pose2 pose_base;              // person in base_link
-  Point2 velocity_base;         // the person's velocity (over ground) in base_link axes
+  Pose2 pose_base;       // person in base_link
+  Point2 velocity_base;  // the person's velocity (over ground) in base_link axes
+  std::array<double, 9> pose_covariance_odom{};  // (x, y, theta), row-major, at the query time
   double position_sigma_m = 0;  // sqrt of the largest eigenvalue of the position covariance
   double heading_sigma_rad = 0;
   Nanos age{0};  // time since the latest accepted tracker pose
+  // The tracker's confidence (the gate's verdict) at the query time; set by whoever holds it,
+  // the filter does not know it.
+  TrackerConfidence confidence = TrackerConfidence::kUnknown;
 };
 HumanState human_state(const HumanTrack& track, Nanos t, const Pose2& base_in_odom,
-                       const HumanEkfConfig& config);
+                       const HumanEkfConfig& config,
+                       TrackerConfidence confidence = TrackerConfidence::kUnknown);
 
 }  // namespace core

@@ -68,7 +68,6 @@ class Amfitrack {
   [[nodiscard]] const AmfitrackCounters& counters() const { return counters_; }
   [[nodiscard]] const std::map<uint8_t, DeviceInfo>& devices() const { return devices_; }
   [[nodiscard]] bool link_failed() const { return link_.failed(); }
-  [[nodiscard]] const PacketLink& link() const { return link_; }
 
  private:
   void on_pose(const SensorMeasurement& m, hal::Nanos stamp);

@@ -6,6 +6,7 @@
 //   - The sensor is worn on the body: its orientation relative to the person's body frame
 //     (x forward, y left, z up) comes from config too; the person's heading is the body x axis
 //     projected on the floor. When the body x axis is (nearly) vertical there is no heading.
+#include <Eigen/Core>
 #include <array>
 #include <optional>
 
@@ -35,9 +36,9 @@ class PersonFrame {
   [[nodiscard]] std::optional<PersonInBase> to_base(const SensorMeasurement& m) const;
 
  private:
-  std::array<double, 9> r_base_source_{};  // row-major
-  std::array<double, 3> t_base_source_{};
-  std::array<double, 9> r_sensor_body_{};  // body axes in sensor coordinates
+  Eigen::Matrix3d r_base_source_;
+  Eigen::Vector3d t_base_source_;
+  Eigen::Matrix3d r_sensor_body_;  // body axes in sensor coordinates
 };
 
 }  // namespace amfitrack

@@ -11,6 +11,7 @@
 #include <string_view>
 
 #include "hal/can/can_frame.hpp"
+#include "hal/capture/log_line.hpp"
 
 namespace hal {
 
@@ -21,39 +22,14 @@ struct CandumpRecord {
   CanFrame frame;
 };
 
-enum class CandumpParse : uint8_t { kRecord, kIgnored, kMalformed };
+using CandumpParse = LogLineParse;  // kRecord, kIgnored, kMalformed
 
 // Parses one line; on kMalformed `error` says why.
 CandumpParse parse_candump_line(std::string_view line, CandumpRecord& out, std::string& error);
 // One line without the newline; `nine_digits` writes nanoseconds instead of microseconds.
 std::string format_candump_line(const CandumpRecord& rec, bool nine_digits = false);
 
-class CandumpReader {
- public:
-  explicit CandumpReader(const std::string& path);
-  [[nodiscard]] bool is_open() const { return in_.is_open(); }
-  // Next record; malformed lines are counted and skipped (see malformed(), last_error()).
-  std::optional<CandumpRecord> next();
-  [[nodiscard]] uint64_t malformed() const { return malformed_; }
-  [[nodiscard]] const std::string& last_error() const { return last_error_; }
-  [[nodiscard]] uint64_t line_number() const { return line_; }
-
- private:
-  std::ifstream in_;
-  uint64_t malformed_ = 0;
-  uint64_t line_ = 0;
-  std::string last_error_;
-};
-
-class CandumpWriter {
- public:
-  explicit CandumpWriter(const std::string& path);
-  [[nodiscard]] bool is_open() const { return out_.is_open(); }
-  void write(const CandumpRecord& rec);
-  void flush() { out_.flush(); }
-
- private:
-  std::ofstream out_;
-};
+using CandumpReader = LineLogReader<CandumpRecord, parse_candump_line>;
+using CandumpWriter = LineLogWriter<CandumpRecord, format_candump_line>;
 
 }  // namespace hal
