@@ -4,7 +4,8 @@
 .PHONY: run test deps build bench fuzz format tidy clean
 
 JOBS ?= $(shell nproc)
-TSAN_TARGETS := test_core_channel test_hal_clock test_firmware_executor test_firmware_daemon
+TSAN_TARGETS := test_core_channel test_hal_clock test_firmware_executor test_firmware_daemon \
+  test_drivers_amfitrack_threads
 FUZZERS := fuzz_candump_line fuzz_slcan_stream fuzz_scout_decode fuzz_amfiprot fuzz_vlp16
 FUZZ_SECONDS ?= 10
 

@@ -138,7 +138,8 @@ int run(int argc, char** argv) {
       return 1;
     }
     daemon.attach_tracker(std::make_unique<amfitrack::ReconnectingLink>(
-        [u = *uri]() { return amfitrack::open_link(u); }, firmware::tracker_reconnect_config(cfg)));
+        [u = *uri]() { return amfitrack::open_link(u); }, firmware::tracker_reconnect_config(cfg),
+        amfitrack::OpenMode::kBackground));
     spdlog::info("tracker: Amfitrack on {} (sensor TX id {})", tracker_uri,
                  cfg.tracker.sensor_tx_id);
   } else if (tracker_uri == "sim") {

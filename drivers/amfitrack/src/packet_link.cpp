@@ -67,8 +67,48 @@ bool HidPacketLink::send(const Packet& p) {
 
 // ---- reconnecting --------------------------------------------------------------------------
 
-ReconnectingLink::ReconnectingLink(Opener opener, const ReconnectConfig& config)
-    : opener_(std::move(opener)), config_(config), backoff_(config.first_retry) {}
+ReconnectingLink::ReconnectingLink(Opener opener, const ReconnectConfig& config, OpenMode mode)
+    : opener_(std::move(opener)), config_(config), backoff_(config.first_retry), mode_(mode) {
+  if (mode_ == OpenMode::kBackground) worker_ = std::thread([this] { worker(); });
+}
+
+ReconnectingLink::~ReconnectingLink() {
+  if (worker_.joinable()) {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    wake_.notify_one();
+    worker_.join();
+  }
+}
+
+void ReconnectingLink::worker() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  for (;;) {
+    wake_.wait(lock, [this] { return requested_ || stop_; });
+    if (stop_) return;
+    requested_ = false;
+    lock.unlock();
+    OpenedLink opened = opener_();  // the slow part, off the caller's thread
+    lock.lock();
+    done_ = std::move(opened);
+  }
+}
+
+void ReconnectingLink::accept(OpenedLink opened, hal::Nanos now) {
+  if (opened.link) {
+    link_ = std::move(opened.link);
+    ++events_.connects;
+    events_.description = opened.description;
+    backoff_ = config_.first_retry;
+    return;
+  }
+  ++events_.open_failures;
+  events_.last_error = opened.error;
+  next_attempt_ = now + backoff_;
+  backoff_ = std::min(backoff_ * 2, config_.max_retry);
+}
 
 void ReconnectingLink::service(hal::Nanos now) {
   if (link_ && link_->failed()) {
@@ -81,20 +121,30 @@ void ReconnectingLink::service(hal::Nanos now) {
     next_attempt_ = now + backoff_;
     return;
   }
-  if (link_ || (attempted_ && now < next_attempt_)) return;
-  attempted_ = true;
-  OpenedLink opened = opener_();
-  if (opened.link) {
-    link_ = std::move(opened.link);
-    ++events_.connects;
-    events_.description = opened.description;
-    backoff_ = config_.first_retry;
+  if (link_) return;
+  if (in_flight_) {
+    // Collect a finished background attempt without ever waiting for the worker.
+    std::unique_lock<std::mutex> lock(mutex_, std::try_to_lock);
+    if (!lock.owns_lock() || !done_) return;
+    OpenedLink opened = std::move(*done_);
+    done_.reset();
+    lock.unlock();
+    in_flight_ = false;
+    accept(std::move(opened), now);
     return;
   }
-  ++events_.open_failures;
-  events_.last_error = opened.error;
-  next_attempt_ = now + backoff_;
-  backoff_ = std::min(backoff_ * 2, config_.max_retry);
+  if (attempted_ && now < next_attempt_) return;
+  attempted_ = true;
+  if (mode_ == OpenMode::kBackground) {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      requested_ = true;
+    }
+    wake_.notify_one();
+    in_flight_ = true;
+    return;
+  }
+  accept(opener_(), now);
 }
 
 std::optional<Packet> ReconnectingLink::receive() {

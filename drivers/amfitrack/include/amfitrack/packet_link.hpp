@@ -2,10 +2,13 @@
 // How Amfiprot packets travel: as COBS frames on a serial port, or one per 64-byte HID report
 // (hidapi). The device shell only sees packets. A ReconnectingLink reopens a link that failed
 // (unplugged) with back-off, so the shell sees one link that is sometimes down.
+#include <condition_variable>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 
 #include "amfitrack/amfiprot_codec.hpp"
 #include "hal/clock.hpp"
@@ -76,10 +79,18 @@ struct LinkEvents {
   std::string description;  // of the open link
 };
 
+// kBackground runs the opener on the link's own (non-real-time) thread: enumerating USB devices
+// and opening them can take milliseconds, which must not happen inside the 120 Hz task. The
+// task's service() then only hands over a finished attempt (try-lock, never blocks).
+enum class OpenMode : uint8_t { kInline, kBackground };
+
 class ReconnectingLink final : public PacketLink {
  public:
   using Opener = std::function<OpenedLink()>;
-  ReconnectingLink(Opener opener, const ReconnectConfig& config);
+  ReconnectingLink(Opener opener, const ReconnectConfig& config, OpenMode mode = OpenMode::kInline);
+  ~ReconnectingLink() override;
+  ReconnectingLink(const ReconnectingLink&) = delete;
+  ReconnectingLink& operator=(const ReconnectingLink&) = delete;
 
   void service(hal::Nanos now) override;
   std::optional<Packet> receive() override;
@@ -91,6 +102,9 @@ class ReconnectingLink final : public PacketLink {
   [[nodiscard]] hal::Nanos next_attempt() const { return next_attempt_; }
 
  private:
+  void accept(OpenedLink opened, hal::Nanos now);
+  void worker();
+
   Opener opener_;
   ReconnectConfig config_;
   std::unique_ptr<PacketLink> link_;
@@ -99,6 +113,15 @@ class ReconnectingLink final : public PacketLink {
   hal::Nanos backoff_{0};
   hal::Nanos next_attempt_{0};
   bool attempted_ = false;
+  // background opening
+  OpenMode mode_;
+  bool in_flight_ = false;  // an attempt was handed to the worker (service side only)
+  std::mutex mutex_;        // guards requested_, stop_, done_
+  std::condition_variable wake_;
+  bool requested_ = false;
+  bool stop_ = false;
+  std::optional<OpenedLink> done_;
+  std::thread worker_;
 };
 
 }  // namespace amfitrack
