@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -16,6 +17,10 @@ namespace {
 // A safety snapshot older than this means the supervisor task is not running.
 constexpr Nanos kSnapshotMaxAge = std::chrono::milliseconds(100);
 constexpr int64_t kNotYet = std::numeric_limits<int64_t>::max();
+// A companion point older than this (policy at 30 Hz: 6 missed runs) is not tracked.
+constexpr Nanos kGoalMaxAge = std::chrono::milliseconds(200);
+// Odometry is moved forward by its velocity for at most this long.
+constexpr double kMaxOdomLagS = 0.1;
 }  // namespace
 
 core::SupervisorConfig supervisor_config(const DaemonConfig& cfg) {
@@ -158,6 +163,8 @@ Daemon::Daemon(const DaemonConfig& cfg, hal::SystemdNotifier& notifier)
       lidar_odom_(kOdomHistory, kOdomHold),
       lidar_warning_(core::from_ms(cfg.logging.warning_interval_ms)),
       space_(interactive_space_config(cfg)),
+      mppi_(mppi_config(cfg)),
+      person_path_(static_cast<size_t>(cfg.mppi.horizon_steps) + 1),
       gate_(stop_limits(cfg)),
       base_send_warning_(core::from_ms(cfg.logging.warning_interval_ms)) {}
 
@@ -424,11 +431,18 @@ void Daemon::policy_task(const core::Tick& tick) {
 void Daemon::control_task(const core::Tick& tick) {
   const auto safety = safety_.read();
   const bool allowed = safety && safety->value.motion_allowed;
-  // No controller yet (issue 6): request standstill. The gate still runs so the stop ramp and
-  // the command stream are real.
-  const core::BodyVelocity requested{};
-  const core::BodyVelocity cmd = gate_.update(allowed, requested, tick.now);
+  // Track q^d only with everything the controller needs, fresh; otherwise the gate stops the
+  // robot the controlled way (the supervisor says why when an input is missing).
+  core::BodyVelocity requested{};
+  bool tracking = false;
+  if (allowed) tracking = run_controller(tick.now, requested);
+  if (!tracking) mppi_.reset();  // a later start must not follow a stale plan
+  control_state_.tracking = tracking;
+  const core::BodyVelocity cmd = gate_.update(allowed && tracking, requested, tick.now);
+  last_command_ = core::Twist{cmd.vx_mps, cmd.vy_mps, cmd.wz_radps};
+  control_state_.command = cmd;
   command_.publish(cmd, tick.now);
+  control_status_.publish(control_state_, tick.now);
   // Every path to the wheels passes the gate above; a zero command is still streamed (the base
   // stops by itself 500 ms after the last one).
   if (base_) {
@@ -439,6 +453,53 @@ void Daemon::control_task(const core::Tick& tick) {
                               hal::to_string(r), base_->counters().write_errors);
     }
   }
+}
+
+bool Daemon::run_controller(Nanos now, core::BodyVelocity& requested) {
+  const auto goal = goal_.read();
+  const auto track = human_track_.read();
+  const auto base = base_health_.read();
+  if (!goal || goal->value.status != core::GoalStatus::kOk || now - goal->stamp > kGoalMaxAge) {
+    return false;
+  }
+  if (!track || !track->value.valid || !base || base->value.odom_stamp == core::kNever) {
+    return false;
+  }
+  // The robot now: the newest wheel odometry moved on by its measured velocity (feedback comes
+  // every 20 ms; at 1 m/s that is 2 cm of lag otherwise).
+  const BaseHealth& b = base->value;
+  const double lag_s = std::clamp(core::to_seconds(now - b.odom_stamp), 0.0, kMaxOdomLagS);
+  const core::Pose2 robot =
+      b.odom * core::Pose2{b.vx_mps * lag_s, b.vy_mps * lag_s, b.wz_radps * lag_s};
+  core::predict_path(track->value, now, mppi_.config().step_s, person_path_);
+  const auto map = costmap_.latest();
+
+  core::MppiInputs in;
+  in.robot = robot;
+  in.current = last_command_;
+  in.goal = goal->value.goal_odom;
+  in.person = person_path_;
+  in.costmap = map.get();
+  in.now = now;
+  const core::MppiOutput out = mppi_.step(in);
+  ++control_state_.runs;
+  if (!out.ok) {
+    ++control_state_.failures;
+    if (!control_state_.numerical_failure) {
+      spdlog::error("control: MPPI numerical failure at run {} (robot {:.3f} {:.3f} {:.3f}, goal "
+                    "{:.3f} {:.3f} {:.3f}): stopping",
+                    control_state_.runs, robot.x_m, robot.y_m, robot.theta_rad,
+                    in.goal.x_m, in.goal.y_m, in.goal.theta_rad);
+    }
+    control_state_.numerical_failure = true;  // the supervisor latches FAULT
+    return false;
+  }
+  control_state_.repaired = out.repaired;
+  if (out.repaired) ++control_state_.repairs;
+  control_state_.min_cost = out.min_cost;
+  control_state_.effective_samples = out.effective_samples;
+  requested = core::BodyVelocity{out.command.vx, out.command.vy, out.command.wz};
+  return true;
 }
 
 // ---- supervisor ------------------------------------------------------------------------------
@@ -467,6 +528,8 @@ void Daemon::supervisor_task(const core::Tick& tick) {
     in.tracker_quality = h.quality;
     in.person_distance_m = h.person_distance_m;
   }
+
+  if (const auto c = control_status_.read()) in.numerical_failure = c->value.numerical_failure;
 
   if (const auto l = lidar_health_.read()) {
     in.lidar_stamp = l->value.packet_stamp;

@@ -28,8 +28,8 @@ const std::array<TaskRow, 8>& task_table() {
       COMPANION_TASK(tracker, 120, 300, kGroupRealtime, 90, ""),
       COMPANION_TASK(base, 50, 200, kGroupRealtime, 80, ""),
       COMPANION_TASK(supervisor, 100, 50, kGroupRealtime, 70, ""),
-      COMPANION_TASK(control, 100, 3000, kGroupRealtime, 60, "MPPI-CBF controller (issue 6)"),
-      COMPANION_TASK(policy, 30, 500, kGroupPlanning, 50, ""),  // objective argmin (policy: #6)
+      COMPANION_TASK(control, 100, 3000, kGroupRealtime, 60, ""),
+      COMPANION_TASK(policy, 30, 500, kGroupPlanning, 50, ""),
       COMPANION_TASK(lidar, 10, 5000, kGroupPerception, 40, ""),
       COMPANION_TASK(notify, 10, 200, kGroupReport, 20, ""),  // systemd watchdog pings
       COMPANION_TASK(report, 1, 2000, kGroupReport, 10, ""),  // status line, summaries

@@ -74,8 +74,10 @@ ReasonSet Supervisor::evaluate(const SafetyInputs& in, Nanos now) {
   set(Reason::kNumericalFailure, in.numerical_failure);
 
   ReasonSet active;
-  for (size_t i = 0; i < kReasonCount; ++i)
+  for (size_t i = 0; i < kReasonCount; ++i) {
+    raw_[i] = raw[i];
     active[i] = debounce_[i].update(raw[i], now);
+  }
   return active;
 }
 
@@ -224,7 +226,12 @@ SupervisorOutput Supervisor::update(const SafetyInputs& in, Nanos now) {
     out.transition.from = prev_state;
     out.transition.to = state_;
     out.transition.reason = reason_;
-    if (reason_ != Reason::kNone) {
+    if (reason_ != Reason::kNone && !raw_[reason_index(reason_)]) {
+      // A cause that already cleared and only waits out its hysteresis (HOLD -> HOLD when a
+      // more important cause resolves first): say so, not the values that look healthy now.
+      (void)std::snprintf(out.transition.values.data(), out.transition.values.size(),
+                          "condition clear, waiting for the hysteresis");
+    } else if (reason_ != Reason::kNone) {
       describe(in, now, reason_, out.transition.values);
     } else {
       (void)std::snprintf(

@@ -96,6 +96,19 @@ struct CompanionGoal {
   core::Pose2 goal_odom;               // the same in odom
   const char* selector = "objective";  // static text: "objective" (or the policy, issue 6)
 };
+// What the control task publishes: how the controller did on its latest run.
+struct ControlStatus {
+  bool tracking = false;           // MPPI ran on a goal (else: holding / stopping)
+  bool numerical_failure = false;  // latched: NaN/Inf from the controller at some run
+  bool repaired = false;           // the QP repair changed the first control
+  double min_cost = 0;             // the best rollout's cost
+  double effective_samples = 0;
+  uint64_t runs = 0;       // MPPI steps so far
+  uint64_t failures = 0;   // MPPI steps that failed
+  uint64_t repairs = 0;    // first controls the QP repair changed
+  core::BodyVelocity command;  // after the supervisor's gate (what went to the base)
+};
+
 // "front", "left", "behind", "right" of the person, from the design point's angle.
 const char* side_of_person(int index, int points);
 core::InteractiveSpaceConfig interactive_space_config(const DaemonConfig& cfg);
@@ -135,6 +148,9 @@ class Daemon {
   [[nodiscard]] const core::LatestValue<LidarHealth>& lidar_health() const { return lidar_health_; }
   [[nodiscard]] const core::SnapshotChannel<core::Costmap>& costmap() const { return costmap_; }
   [[nodiscard]] const core::LatestValue<CompanionGoal>& goal() const { return goal_; }
+  [[nodiscard]] const core::LatestValue<ControlStatus>& control_status() const {
+    return control_status_;
+  }
   // The learned selector (optional; without it the objective argmin selects). Before start.
   void attach_policy(core::PolicyFile policy);
   // The executor running the bindings (the supervisor and the report read its statistics).
@@ -167,6 +183,8 @@ class Daemon {
   [[nodiscard]] std::string timing_summary() const;
 
  private:
+  // One MPPI-CBF step toward the current goal; false when there is nothing to track.
+  bool run_controller(core::Nanos now, core::BodyVelocity& requested);
   std::string safety_text(const SafetySnapshot& s) const;
   std::string tracker_text(core::Nanos now) const;
   std::string lidar_text(core::Nanos now) const;
@@ -226,6 +244,11 @@ class Daemon {
   core::LatestValue<BaseHealth> base_health_;
 
   // control task state
+  core::Mppi mppi_;
+  std::vector<core::Pose2> person_path_;  // the person's predicted poses at the MPPI steps
+  core::Twist last_command_;              // the gate's previous output (MPPI's start control)
+  ControlStatus control_state_;
+  core::LatestValue<ControlStatus> control_status_;
   core::MotionGate gate_;
   RateLimitedLog base_send_warning_;
   core::LatestValue<core::BodyVelocity> command_;

@@ -343,3 +343,26 @@ TEST(Supervisor, ReasonCodesAreStable) {
     EXPECT_FALSE(info.name.empty());
   }
 }
+
+TEST(Supervisor, AHoldCauseThatClearedButWaitsForHysteresisSaysSoNotItsHealthyValues) {
+  // Tracker silent and costmap stale together; the tracker (more important) recovers first, so
+  // the primary reason moves to the costmap, whose condition has cleared too and only waits.
+  Harness h;
+  h.arm();
+  const Nanos frozen = h.now_;
+  h.run(700ms, [&] {
+    auto in = h.healthy();
+    in.tracker_stamp = frozen;
+    in.costmap_stamp = frozen;
+    return in;
+  });
+  const Nanos tracker_back = h.now_;
+  auto out = h.run(1020ms, [&] {
+    auto in = h.healthy();
+    if (h.now_ < tracker_back + 30ms) in.costmap_stamp = frozen;
+    return in;
+  });
+  EXPECT_EQ(out.state, SafetyState::kHold);
+  EXPECT_EQ(out.reason, Reason::kCostmapStale);
+  EXPECT_EQ(values(h.last_transition_), "condition clear, waiting for the hysteresis");
+}

@@ -106,6 +106,7 @@ class Supervisor {
   SafetyState state_ = SafetyState::kInit;
   Reason reason_ = Reason::kStarting;
   std::array<Debounce, kReasonCount> debounce_{};
+  ReasonSet raw_;  // the conditions before hysteresis, at the latest update
   Nanos all_clear_since_ = kNever;
   uint64_t last_write_errors_ = 0;
   uint64_t last_overruns_ = 0;
