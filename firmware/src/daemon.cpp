@@ -116,6 +116,7 @@ core::MppiConfig mppi_config(const DaemonConfig& cfg) {
   c.step_s = m.step_s;
   c.samples = static_cast<int>(m.samples);
   c.lambda = m.lambda;
+  c.min_effective_samples = static_cast<int>(m.min_effective_samples);
   c.sigma = {m.noise_vx_mps, m.noise_vy_mps, m.noise_wz_radps};
   c.q = {m.q_x, m.q_y, m.q_theta};
   c.terminal_weight = m.terminal_weight;
@@ -165,6 +166,7 @@ Daemon::Daemon(const DaemonConfig& cfg, hal::SystemdNotifier& notifier)
       space_(interactive_space_config(cfg)),
       mppi_(mppi_config(cfg)),
       person_path_(static_cast<size_t>(cfg.mppi.horizon_steps) + 1),
+      goal_path_(person_path_.size()),
       gate_(stop_limits(cfg)),
       base_send_warning_(core::from_ms(cfg.logging.warning_interval_ms)) {}
 
@@ -316,7 +318,7 @@ void Daemon::base_task(const core::Tick& tick) {
 }
 // ---- lidar: VLP-16 packets -> scans -> voxel grid -> costmap snapshot --------------------------
 
-void Daemon::attach_lidar(std::unique_ptr<hal::UdpReceiver> data) {
+void Daemon::attach_lidar(std::unique_ptr<hal::DatagramSource> data) {
   lidar_rx_ = std::move(data);
   lidar_ = std::make_unique<LidarPipeline>(cfg_);
 }
@@ -422,6 +424,7 @@ void Daemon::policy_task(const core::Tick& tick) {
     g.free_points = space_.free_count();
     g.goal_base = s.goal_base;
     g.goal_odom = robot_odom * s.goal_base;
+    g.person_odom = h.pose_odom;
   }
   goal_.publish(g, tick.now);
 }
@@ -472,12 +475,17 @@ bool Daemon::run_controller(Nanos now, core::BodyVelocity& requested) {
   const core::Pose2 robot =
       b.odom * core::Pose2{b.vx_mps * lag_s, b.vy_mps * lag_s, b.wz_radps * lag_s};
   core::predict_path(track->value, now, mppi_.config().step_s, person_path_);
+  // q^d is a point of the person's interactive space: it walks with them over the horizon.
+  const core::Pose2 goal_in_person = goal->value.person_odom.inverse() * goal->value.goal_odom;
+  for (size_t k = 0; k < person_path_.size(); ++k)
+    goal_path_[k] = person_path_[k] * goal_in_person;
   const auto map = costmap_.latest();
 
   core::MppiInputs in;
   in.robot = robot;
   in.current = last_command_;
   in.goal = goal->value.goal_odom;
+  in.goal_path = goal_path_;
   in.person = person_path_;
   in.costmap = map.get();
   in.now = now;

@@ -38,6 +38,7 @@ Mppi::Mppi(const MppiConfig& config)
       weight_(cost_.size()),
       rng_state_(config.seed * 0x9E3779B97F4A7C15ULL + 1) {
   person_frames_.reserve(static_cast<size_t>(config.horizon_steps) + 1);
+  goal_frames_.reserve(static_cast<size_t>(config.horizon_steps) + 1);
   active_.reserve(weight_.size());
   // Standard normals by Box-Muller from the seeded generator: same seed, same pool.
   for (size_t i = 0; i + 1 < pool_.size(); i += 2) {
@@ -91,11 +92,6 @@ void Mppi::rollout_block(size_t block, const MppiInputs& in) {
   constexpr size_t kL = kLanes;
   const size_t horizon = mean_.size();
   const auto dt = static_cast<float>(cfg_.step_s);
-  const auto gx = static_cast<float>(in.goal.x_m);
-  const auto gy = static_cast<float>(in.goal.y_m);
-  const auto gth = static_cast<float>(in.goal.theta_rad);
-  const auto cg = static_cast<float>(goal_cos_);
-  const auto sg = static_cast<float>(goal_sin_);
   const auto qx = static_cast<float>(cfg_.q[0]);
   const auto qy = static_cast<float>(cfg_.q[1]);
   const auto qt = static_cast<float>(cfg_.q[2]);
@@ -118,7 +114,16 @@ void Mppi::rollout_block(size_t block, const MppiInputs& in) {
   const bool with_map = in.costmap != nullptr;
   const auto collision = static_cast<float>(cfg_.collision_cost);
 
-  // Tracking: the error in the goal's frame, the angle wrapped to (-pi, pi].
+  // Tracking: the error in the frame of the goal at step k, the angle wrapped to (-pi, pi].
+  float gx = 0, gy = 0, gth = 0, cg = 1, sg = 0;
+  auto goal_at = [&](size_t k) {
+    const GoalFrame& g = goal_frames_[std::min(k, goal_frames_.size() - 1)];
+    gx = static_cast<float>(g.x);
+    gy = static_cast<float>(g.y);
+    gth = static_cast<float>(g.theta);
+    cg = static_cast<float>(g.c);
+    sg = static_cast<float>(g.s);
+  };
   auto tracking = [&](float px, float py, float pth) {
     const float dx = px - gx;
     const float dy = py - gy;
@@ -164,6 +169,7 @@ void Mppi::rollout_block(size_t block, const MppiInputs& in) {
     const float* n0 = &pool_[(base + (k * 3 + 0) * kL) & (kPoolSize - 1)];
     const float* n1 = &pool_[(base + (k * 3 + 1) * kL) & (kPoolSize - 1)];
     const float* n2 = &pool_[(base + (k * 3 + 2) * kL) & (kPoolSize - 1)];
+    goal_at(k + 1);  // the control of step k leads to the state of step k + 1
     for (size_t j = 0; j < kL; ++j) {
       // The sampled control, in the velocity box and reachable from the previous one with the
       // base's accelerations (so the rollouts predict what the base will actually do).
@@ -204,6 +210,7 @@ void Mppi::rollout_block(size_t block, const MppiInputs& in) {
     }
   }
   const auto tw = static_cast<float>(cfg_.terminal_weight);
+  goal_at(horizon);
   for (size_t j = 0; j < kL; ++j) {
     cost_[block * kL + j] = static_cast<double>(cost[j] + tw * tracking(x[j], y[j], th[j]));
   }
@@ -214,8 +221,15 @@ MppiOutput Mppi::step(const MppiInputs& in) {
   const double elapsed = has_time_ ? std::clamp(to_seconds(in.now - last_), 1e-3, 0.2) : 0.01;
   shift_mean(in.now);
   // Per-step preparation shared by all samples.
-  goal_cos_ = std::cos(in.goal.theta_rad);
-  goal_sin_ = std::sin(in.goal.theta_rad);
+  goal_frames_.clear();
+  if (in.goal_path.empty()) {
+    goal_frames_.push_back({in.goal.x_m, in.goal.y_m, in.goal.theta_rad, std::cos(in.goal.theta_rad),
+                            std::sin(in.goal.theta_rad)});
+  }
+  for (size_t k = 0; k < in.goal_path.size() && k < goal_frames_.capacity(); ++k) {
+    const Pose2& g = in.goal_path[k];
+    goal_frames_.push_back({g.x_m, g.y_m, g.theta_rad, std::cos(g.theta_rad), std::sin(g.theta_rad)});
+  }
   robot_cos_ = std::cos(in.robot.theta_rad);
   robot_sin_ = std::sin(in.robot.theta_rad);
   person_frames_.clear();
@@ -234,19 +248,46 @@ MppiOutput Mppi::step(const MppiInputs& in) {
   double min_cost = std::numeric_limits<double>::infinity();
   for (const double c : cost_)
     min_cost = std::min(min_cost, c);
-  double total = 0.0;
-  for (size_t m = 0; m < cost_.size(); ++m) {
-    weight_[m] = std::isfinite(cost_[m]) ? std::exp(-(cost_[m] - min_cost) / cfg_.lambda) : 0.0;
-    total += weight_[m];
-  }
-  if (!std::isfinite(min_cost) || !(total > 0.0)) {
+  if (!std::isfinite(min_cost)) {
     reset();
     return out;  // ok = false, zero command
   }
-  double sum_sq = 0.0;
-  for (double& w : weight_) {
-    w /= total;
-    sum_sq += w * w;
+  // Importance weights at temperature lambda; raised (geometrically, then bisected in log space)
+  // when fewer than min_effective_samples samples would carry the update.
+  auto weigh = [&](double lambda) {
+    double total = 0.0;
+    for (size_t m = 0; m < cost_.size(); ++m) {
+      weight_[m] = std::isfinite(cost_[m]) ? std::exp(-(cost_[m] - min_cost) / lambda) : 0.0;
+      total += weight_[m];
+    }
+    double sum_sq = 0.0;
+    for (double& w : weight_) {
+      w /= total;
+      sum_sq += w * w;
+    }
+    return 1.0 / sum_sq;  // total >= 1: the best sample weighs exp(0)
+  };
+  double lambda = cfg_.lambda;
+  double ess = weigh(lambda);
+  const auto want = static_cast<double>(std::min<size_t>(
+      static_cast<size_t>(std::max(cfg_.min_effective_samples, 0)), cost_.size()));
+  if (ess < want) {
+    double lo = lambda;
+    double hi = lambda;
+    for (int i = 0; i < 40 && weigh(hi) < want; ++i) {
+      lo = hi;
+      hi *= 8.0;
+    }
+    for (int i = 0; i < 12; ++i) {
+      const double mid = std::sqrt(lo * hi);
+      (weigh(mid) < want ? lo : hi) = mid;
+    }
+    lambda = hi;
+    ess = weigh(lambda);
+  }
+  if (!std::isfinite(ess)) {
+    reset();
+    return out;
   }
   // mean_k += sum_m w_m sigma n_{m,k}, over the samples that carry weight (with lambda = 1 and
   // costs in the thousands, a handful).
@@ -277,7 +318,8 @@ MppiOutput Mppi::step(const MppiInputs& in) {
   }
   out.nominal = mean_.front();
   out.min_cost = min_cost;
-  out.effective_samples = 1.0 / sum_sq;
+  out.effective_samples = ess;
+  out.lambda = lambda;
   Twist u = out.nominal;
   if (!in.person.empty()) {
     const Pose2& p0 = in.person.front();

@@ -26,7 +26,7 @@
 #include "firmware/logging.hpp"
 #include "firmware/scheduler/executor.hpp"
 #include "hal/can/can_bus.hpp"
-#include "hal/net/udp_socket.hpp"
+#include "hal/net/datagram_source.hpp"
 #include "hal/sd_notify.hpp"
 #include "scout_mini/scout_mini.hpp"
 
@@ -94,6 +94,7 @@ struct CompanionGoal {
   size_t free_points = 0;              // |P|
   core::Pose2 goal_base;               // q^d in base_link at the time of the choice
   core::Pose2 goal_odom;               // the same in odom
+  core::Pose2 person_odom;             // the person when q^d was chosen (q^d moves with them)
   const char* selector = "objective";  // static text: "objective" (or the policy, issue 6)
 };
 // What the control task publishes: how the controller did on its latest run.
@@ -144,7 +145,7 @@ class Daemon {
   }
   [[nodiscard]] const core::HumanEkfConfig& human_config() const { return human_config_; }
   // The VLP-16's data socket (optional: without it the supervisor holds, lidar silent).
-  void attach_lidar(std::unique_ptr<hal::UdpReceiver> data);
+  void attach_lidar(std::unique_ptr<hal::DatagramSource> data);
   [[nodiscard]] const core::LatestValue<LidarHealth>& lidar_health() const { return lidar_health_; }
   [[nodiscard]] const core::SnapshotChannel<core::Costmap>& costmap() const { return costmap_; }
   [[nodiscard]] const core::LatestValue<CompanionGoal>& goal() const { return goal_; }
@@ -223,7 +224,7 @@ class Daemon {
   core::LatestValue<core::HumanTrack> human_track_;
 
   // lidar (socket and pipeline owned by the lidar task)
-  std::unique_ptr<hal::UdpReceiver> lidar_rx_;
+  std::unique_ptr<hal::DatagramSource> lidar_rx_;
   std::unique_ptr<LidarPipeline> lidar_;
   core::PoseHistory lidar_odom_;
   LidarHealth lidar_state_;
@@ -246,6 +247,7 @@ class Daemon {
   // control task state
   core::Mppi mppi_;
   std::vector<core::Pose2> person_path_;  // the person's predicted poses at the MPPI steps
+  std::vector<core::Pose2> goal_path_;    // q^d carried along person_path_
   core::Twist last_command_;              // the gate's previous output (MPPI's start control)
   ControlStatus control_state_;
   core::LatestValue<ControlStatus> control_status_;

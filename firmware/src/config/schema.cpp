@@ -652,6 +652,16 @@ std::vector<FieldSpec> build() {
        1e-6,
        1e6,
        {}},
+      {"mppi.min_effective_samples",
+       "count",
+       "Floor on the effective sample size 1/sum(w^2): lambda is raised for an update until at "
+       "least this many samples carry it (0: lambda as given). With the paper's lambda = 1 and "
+       "costs in the thousands the best sample alone carries the update, and the command is "
+       "that sample's noise.",
+       FIELD(mppi.min_effective_samples),
+       0,
+       100000,
+       {}},
       {"mppi.q_x",
        "1/m^2",
        "c_x: weight of the x tracking error in Q (paper: 50).",

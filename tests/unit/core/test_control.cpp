@@ -41,7 +41,7 @@ struct Loop {
   explicit Loop(const core::MppiConfig& c) : mppi(c) {}
   core::MppiOutput tick(const Pose2& goal, std::span<const Pose2> person,
                         const core::Costmap* map) {
-    core::MppiInputs in{robot, last, goal, person, map, t};
+    core::MppiInputs in{robot, last, goal, person, map, t, {}};
     const auto out = mppi.step(in);
     robot = integrate(robot, out.command, 0.01);  // 100 Hz
     last = out.command;

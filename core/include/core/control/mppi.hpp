@@ -2,7 +2,7 @@
 // MPPI with a discrete-time CBF cost (paper, section V), on the robot's planar pose in odom.
 //   state (x, y, theta), control (vx, vy, wz) in the body frame, Euler steps of dt:
 //     x += (vx cos th - vy sin th) dt,  y += (vx sin th + vy cos th) dt,  th += wz dt
-//   per step k: tracking (q_k - q^d)^T Q (q_k - q^d), the error expressed in the goal's frame
+//   per step k: tracking (q_k - q^d_k)^T Q (q_k - q^d_k), the error expressed in the goal's frame
 //   (e_x along the goal heading, e_y across it, e_theta wrapped); c_collision when the costmap
 //   cost (bilinear) >= R; c_safe max((1 - delta) h_k - h_{k+1}, 0) with h the ellipse barrier
 //   around the person's PREDICTED pose at step k; the control cost lambda u^T Sigma^-1 eps;
@@ -29,6 +29,9 @@ struct MppiConfig {
   double step_s = 0.1;      // dt
   int samples = 2000;       // M
   double lambda = 1.0;
+  // Floor on 1/sum(w^2): lambda is raised (per update) until this many samples carry the update;
+  // 0 keeps lambda. See MppiOutput::lambda.
+  int min_effective_samples = 0;
   std::array<double, 3> sigma = {0.3, 0.3, 0.5};  // noise std of vx, vy, wz
   std::array<double, 3> q = {50.0, 10.0, 20.0};   // Q = diag(c_x, c_y, c_theta)
   double terminal_weight = 2.0;                   // the terminal cost is this times Q's
@@ -52,6 +55,9 @@ struct MppiInputs {
   std::span<const Pose2> person;     // predicted person poses at steps 0..K (odom); may be empty
   const Costmap* costmap = nullptr;  // may be null (no collision cost)
   Nanos now{0};
+  // q^d at steps 0..K (odom) when it moves with the person (the interactive space is attached
+  // to them); empty: `goal` at every step.
+  std::span<const Pose2> goal_path;
 };
 
 struct MppiOutput {
@@ -62,6 +68,7 @@ struct MppiOutput {
   bool repair_feasible = true;
   double min_cost = 0;           // best sample's cost
   double effective_samples = 0;  // 1 / sum(w^2): how many samples carried the update
+  double lambda = 0;             // the temperature used (>= config lambda)
 };
 
 class Mppi {
@@ -94,7 +101,11 @@ class Mppi {
     double x, y, c, s;  // predicted person position and heading cos/sin (odom)
   };
   std::vector<PersonFrame> person_frames_;  // K + 1 (capacity fixed at construction)
-  double goal_cos_ = 1, goal_sin_ = 0, robot_cos_ = 1, robot_sin_ = 0;
+  struct GoalFrame {
+    double x, y, theta, c, s;  // q^d at a step and its heading's cos/sin
+  };
+  std::vector<GoalFrame> goal_frames_;  // 1 or K + 1 (capacity fixed at construction)
+  double robot_cos_ = 1, robot_sin_ = 0;
   bool has_time_ = false;
   Nanos last_{0};
 };

@@ -122,6 +122,7 @@ struct DaemonConfig {
     double step_s = 0;
     int64_t samples = 0;
     double lambda = 0;
+    int64_t min_effective_samples = 0;
     double q_x = 0;
     double q_y = 0;
     double q_theta = 0;

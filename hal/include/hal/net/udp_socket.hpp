@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "hal/clock.hpp"
+#include "hal/net/datagram_source.hpp"
 
 namespace hal {
 
@@ -21,23 +22,7 @@ struct UdpEndpoint {
 // "udp:<addr>:<port>" or "<addr>:<port>"; nullopt-like: returns false and says why.
 bool parse_udp_endpoint(const std::string& text, UdpEndpoint& out, std::string& error);
 
-struct UdpStats {
-  uint64_t datagrams = 0;
-  uint64_t bytes = 0;
-  uint64_t truncated = 0;     // larger than the receive buffer: dropped
-  uint64_t kernel_drops = 0;  // socket queue overflowed (SO_RXQ_OVFL; the kernel reports them
-                              // with the next datagram it queues), cumulative
-  uint64_t errors = 0;        // recvmsg errors other than "nothing to read"
-};
-
-struct UdpDatagram {
-  std::span<const uint8_t> bytes;
-  Nanos stamp{0};            // kernel receive time (monotonic), or the drain time
-  uint32_t source_ipv4 = 0;  // host byte order
-  uint16_t source_port = 0;
-};
-
-class UdpReceiver {
+class UdpReceiver final : public DatagramSource {
  public:
   struct OpenResult {
     std::unique_ptr<UdpReceiver> receiver;
@@ -45,15 +30,16 @@ class UdpReceiver {
   };
   // `receive_buffer_bytes`: SO_RCVBUF asked for (the kernel may cap it: see buffer_bytes()).
   static OpenResult open(const UdpEndpoint& endpoint, int receive_buffer_bytes = 4 << 20);
-  ~UdpReceiver();
+  ~UdpReceiver() override;
   UdpReceiver(const UdpReceiver&) = delete;
   UdpReceiver& operator=(const UdpReceiver&) = delete;
 
   // Reads up to `max_datagrams` queued datagrams without blocking and hands each to `on`
   // (the span is valid during the call). `now` is the monotonic time of this drain.
-  size_t drain(size_t max_datagrams, Nanos now, const std::function<void(const UdpDatagram&)>& on);
+  size_t drain(size_t max_datagrams, Nanos now,
+               const std::function<void(const UdpDatagram&)>& on) override;
 
-  [[nodiscard]] const UdpStats& stats() const { return stats_; }
+  [[nodiscard]] UdpStats stats() const override { return stats_; }
   [[nodiscard]] uint16_t port() const { return port_; }  // the bound port (for port 0)
   [[nodiscard]] int buffer_bytes() const { return buffer_bytes_; }
   [[nodiscard]] int fd() const { return fd_; }

@@ -1,0 +1,101 @@
+#pragma once
+// The evaluation's measurements of one run, exactly as reference/evaluation.md defines them:
+//  - failure: a collision (the robot's footprint touches an obstacle or a person), or the robot
+//    centre more than 2 m from the person continuously for more than 5 s;
+//  - UT: seconds with the robot centre closer than 0.45 m to the person (Hall's intimate zone);
+//    also the seconds inside the CBF ellipse (h < 0);
+//  - tracking error e = q^d - q^r in the robot frame, RMSE of e_x, e_y, e_theta (wrapped), over
+//    the time the supervisor lets the robot move toward a chosen point;
+//  - minimum clearances, the side distribution of the robot around the person (8 sectors of
+//    the person's frame: 0 = front, 2 = left, 4 = behind, 6 = right), command jerk.
+// Fed once per world step with the truth and what the daemon decided.
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/geometry/pose2.hpp"
+
+namespace sim {
+
+struct RunSample {  // for pictures: every 100 ms
+  double t_s = 0;
+  core::Pose2 robot;   // world
+  core::Pose2 person;  // world
+  std::vector<core::Point2> pedestrians;
+  bool has_goal = false;
+  core::Point2 goal;  // q^d in the world
+  bool active = false;
+  int side = -1;  // sector of the chosen point (0..7), -1 none
+};
+
+struct RunMetrics {
+  double duration_s = 0;
+  bool success = true;
+  std::string failure;  // "" or "collision with ... at t=..", "lost the person ..."
+  bool collision = false;
+  double collision_t_s = -1;
+  double longest_far_s = 0;  // longest stretch > 2 m from the person
+  double uncomfortable_s = 0;
+  double inside_ellipse_s = 0;
+  double active_s = 0;  // time in ACTIVE
+  double tracking_s = 0;
+  double rmse_ex_m = 0, rmse_ey_m = 0, rmse_etheta_rad = 0;
+  double min_static_clearance_m = 1e9;
+  double min_people_clearance_m = 1e9;
+  double min_person_distance_m = 1e9, max_person_distance_m = 0;
+  double mean_person_distance_m = 0;
+  std::array<double, 8> side_time_s{};  // robot's sector around the person, while ACTIVE
+  double rms_jerk = 0;                  // of the commanded planar velocity, m/s^3
+  uint64_t stops = 0;                   // ACTIVE -> not ACTIVE transitions
+};
+
+struct MetricsConfig {
+  double ellipse_a_m = 1.0, ellipse_b_m = 0.7;
+  double intimate_m = 0.45;
+  double far_m = 2.0;
+  double far_max_s = 5.0;
+  double sample_period_s = 0.1;
+};
+
+// What the daemon decided at this instant (from its channels).
+struct DaemonView {
+  bool active = false;
+  bool has_goal = false;
+  core::Pose2 goal_odom;
+  core::Pose2 robot_odom;  // the daemon's own odometry, the frame of goal_odom
+  core::Pose2 goal_world;
+  int side = -1;
+  double cmd_vx = 0, cmd_vy = 0;
+};
+
+class RunMetricsRecorder {
+ public:
+  explicit RunMetricsRecorder(const MetricsConfig& config = {}) : config_(config) {}
+
+  void record(double t_s, double dt_s, const core::Pose2& robot, const core::Pose2& person,
+              const std::vector<core::Point2>& pedestrians, double static_clearance_m,
+              double people_clearance_m, const DaemonView& view);
+  [[nodiscard]] RunMetrics finish() const;
+  [[nodiscard]] const std::vector<RunSample>& samples() const { return samples_; }
+
+ private:
+  MetricsConfig config_;
+  RunMetrics m_;
+  double far_since_s_ = -1;
+  double ex2_ = 0, ey2_ = 0, eth2_ = 0;
+  double dist_sum_ = 0, dist_time_ = 0;
+  double next_sample_s_ = 0;
+  bool was_active_ = false;
+  double last_vx_ = 0, last_vy_ = 0, last_ax_ = 0, last_ay_ = 0, jerk2_ = 0;
+  double jerk_time_ = 0;
+  double jerk_next_s_ = 0;
+  int jerk_steps_ = 0;
+  std::vector<RunSample> samples_;
+};
+
+// Sector 0..7 of an angle in the person's frame (0 = ahead, counter-clockwise).
+int sector_of(double angle_rad);
+const char* sector_name(int sector);
+
+}  // namespace sim

@@ -1,0 +1,51 @@
+#pragma once
+// One closed-loop run of the daemon in the simulated world on the simulated clock: the real
+// task table (single-threaded, deterministic), the real drivers, the devices' real bytes. Used
+// by the integration tests, companion-eval and `companiond --sim-clock`.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "firmware/config/daemon_config.hpp"
+#include "hal/can/can_frame.hpp"
+#include "sim/run_metrics.hpp"
+#include "sim/scenario.hpp"
+#include "sim/sim_world.hpp"
+
+namespace firmware {
+class Daemon;
+}
+
+namespace sim {
+
+// The simulator's settings that must match the daemon's configuration (sensor mounts, the
+// robot's footprint and limits), taken from it.
+SimWorldConfig world_config(const firmware::DaemonConfig& cfg, uint32_t seed);
+
+// What the daemon decided, read from its channels, with the goal placed in the world.
+DaemonView daemon_view(const firmware::Daemon& daemon, const core::Pose2& robot_world);
+
+struct SimRunOptions {
+  firmware::DaemonConfig config;
+  Scenario scenario;
+  uint32_t seed = 1;
+  double duration_s = 0;  // 0: the scenario's
+  // Called every world step (5 ms) before the world advances: fault injection, observation.
+  std::function<void(double t_s, SimWorld& world, firmware::Daemon& daemon)> script;
+  bool capture_can = false;  // keep every CAN frame the daemon sends
+  bool quiet = true;         // daemon logs at warning level and above only
+};
+
+struct SimRunResult {
+  RunMetrics metrics;
+  std::vector<RunSample> samples;
+  std::vector<double> policy_ms;   // wall time of every policy-task run
+  std::vector<double> control_ms;  // wall time of every control-task run
+  std::vector<hal::CanFrame> can_out;
+  std::string final_status;
+  double wall_s = 0;
+};
+
+SimRunResult run_simulation(const SimRunOptions& options);
+
+}  // namespace sim

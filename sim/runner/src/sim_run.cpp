@@ -1,0 +1,128 @@
+#include "sim/sim_run.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <thread>
+
+#include "firmware/daemon.hpp"
+#include "firmware/task_table.hpp"
+#include "hal/sd_notify.hpp"
+#include "hal/sim_clock.hpp"
+
+namespace sim {
+
+SimWorldConfig world_config(const firmware::DaemonConfig& cfg, uint32_t seed) {
+  SimWorldConfig w;
+  w.tracker.sensor_tx_id = static_cast<uint8_t>(cfg.tracker.sensor_tx_id);
+  w.tracker.seed = seed;
+  w.tracker.position_noise_m = 0.01;
+  w.tracker.heading_noise_rad = 0.02;
+  w.tracker_extrinsics = firmware::tracker_extrinsics(cfg);
+  w.lidar.seed = seed;
+  w.lidar.mount_x_m = cfg.lidar.x_m;
+  w.lidar.mount_y_m = cfg.lidar.y_m;
+  w.lidar.mount_z_m = cfg.lidar.z_m;
+  w.lidar.mount_yaw_rad = cfg.lidar.yaw_rad;
+  w.footprint_x_min_m = cfg.costmap.footprint_x_min_m;
+  w.footprint_x_max_m = cfg.costmap.footprint_x_max_m;
+  w.footprint_y_min_m = cfg.costmap.footprint_y_min_m;
+  w.footprint_y_max_m = cfg.costmap.footprint_y_max_m;
+  w.base.linear_accel_mps2 = cfg.limits.linear_accel_max_mps2;
+  w.base.angular_accel_radps2 = cfg.limits.angular_accel_max_radps2;
+  return w;
+}
+
+DaemonView daemon_view(const firmware::Daemon& daemon, const core::Pose2& robot_world) {
+  DaemonView v;
+  const auto s = daemon.safety().read();
+  v.active = s && s->value.state == core::SafetyState::kActive;
+  const auto b = daemon.base_health().read();
+  if (b) v.robot_odom = b->value.odom;
+  const auto g = daemon.goal().read();
+  if (g && g->value.status == core::GoalStatus::kOk) {
+    v.has_goal = true;
+    v.goal_odom = g->value.goal_odom;
+    v.goal_world = robot_world * (v.robot_odom.inverse() * v.goal_odom);
+    v.side = g->value.points > 0 ? (8 * g->value.index + g->value.points / 2) / g->value.points % 8
+                                 : -1;
+  }
+  if (const auto c = daemon.command().read()) {
+    v.cmd_vx = c->value.vx_mps;
+    v.cmd_vy = c->value.vy_mps;
+  }
+  return v;
+}
+
+SimRunResult run_simulation(const SimRunOptions& o) {
+  using Clock = std::chrono::steady_clock;
+  const auto wall_start = Clock::now();
+  SimRunResult result;
+  const auto level = spdlog::get_level();
+  if (o.quiet) spdlog::set_level(spdlog::level::warn);
+
+  hal::SimClock clock;
+  hal::SystemdNotifier notifier;  // no NOTIFY_SOCKET in a simulation: a no-op
+  SimWorld world(o.scenario, world_config(o.config, o.seed), clock);
+  firmware::DaemonConfig cfg = o.config;
+  cfg.mppi.seed = o.seed;
+  firmware::Daemon daemon(cfg, notifier);
+  daemon.attach_base(world.take_base_bus());
+  daemon.attach_tracker(world.take_tracker_link());
+  daemon.attach_lidar(world.take_lidar_source());
+  std::unique_ptr<hal::VirtualCanBus> sniffer = world.open_can_sniffer();
+
+  RunMetricsRecorder recorder(MetricsConfig{cfg.interactive_space.ellipse_a_m,
+                                            cfg.interactive_space.ellipse_b_m});
+  auto tasks = daemon.bindings();
+  for (auto& t : tasks) {
+    // Wall time of the planning tasks (the simulated clock does not advance inside a task).
+    std::vector<double>* into = t.spec.name == "policy"    ? &result.policy_ms
+                                : t.spec.name == "control" ? &result.control_ms
+                                                           : nullptr;
+    if (into == nullptr) continue;
+    t.fn = [into, fn = t.fn](const core::Tick& tick) {
+      const auto t0 = Clock::now();
+      fn(tick);
+      into->push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+    };
+  }
+  const double step_s = world.config().step_s;
+  const auto step_ns = static_cast<uint32_t>(std::lround(1.0 / step_s));
+  tasks.push_back({core::TaskSpec{"world", step_ns, 1000, firmware::kGroupRealtime, 255},
+                   [&](const core::Tick& tick) {
+                     const double t_s = core::to_seconds(tick.now);
+                     if (o.script) o.script(t_s, world, daemon);
+                     world.step(tick.now);
+                     const core::Pose2 robot = world.robot_pose();
+                     recorder.record(t_s, step_s, robot, world.person_pose(),
+                                     world.pedestrian_positions(),
+                                     world.footprint_clearance_static(),
+                                     world.footprint_clearance_people(),
+                                     daemon_view(daemon, robot));
+                     while (auto f = sniffer->receive()) {
+                       if (o.capture_can) result.can_out.push_back(f->frame);
+                     }
+                   }});
+  firmware::Executor executor(clock, firmware::group_table(), std::move(tasks));
+  daemon.attach(executor);
+  daemon.mark_initialized();
+  const double duration = o.duration_s > 0 ? o.duration_s : o.scenario.duration_s;
+  const core::Nanos end(static_cast<int64_t>(duration * 1e9));
+  clock.set_horizon(end);
+  std::thread stopper([&] {
+    clock.wait_until_idle_at(end);
+    executor.stop();
+  });
+  executor.run(core::Nanos(0));
+  stopper.join();
+
+  result.metrics = recorder.finish();
+  result.samples = recorder.samples();
+  result.final_status = daemon.status_line();
+  result.wall_s = std::chrono::duration<double>(Clock::now() - wall_start).count();
+  spdlog::set_level(level);
+  return result;
+}
+
+}  // namespace sim

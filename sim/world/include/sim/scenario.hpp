@@ -1,0 +1,53 @@
+#pragma once
+// What a simulated run contains: the fixed world, the person's walk, the pedestrians (social
+// force) and replayed recorded people, where the robot starts, and how long it lasts. Built-in
+// scenarios follow the paper's section VI (reference/evaluation.md); each is selectable by name.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sim/social_force.hpp"
+#include "sim/static_world.hpp"
+#include "sim/trajectory.hpp"
+
+namespace sim {
+
+struct Scenario {
+  std::string name;
+  std::string description;
+  StaticWorld world;
+  Trajectory person;          // the followed person (world frame)
+  double person_radius_m = 0.25;
+  core::Pose2 robot_start;    // world frame
+  std::vector<Pedestrian> pedestrians;
+  std::vector<Trajectory> replayed;  // recorded people: move as recorded, avoid no one
+  double duration_s = 60.0;
+};
+
+struct ScenarioInfo {
+  const char* name;
+  const char* description;
+};
+// The built-in scenarios, in the reference's order.
+const std::vector<ScenarioInfo>& builtin_scenarios();
+// A built-in scenario by name (seeded where it has randomness); nullopt for an unknown name.
+std::optional<Scenario> make_scenario(const std::string& name, uint32_t seed = 1);
+
+// Options for the seeded random benchmark (scenario 7 and the crowd and speed variants).
+struct RandomScenarioOptions {
+  int pedestrians = 10;
+  int obstacles = 8;
+  double speed_min_mps = 0.7;
+  double speed_max_mps = 1.5;
+  double duration_s = 60.0;
+};
+Scenario random_scenario(uint32_t seed, const RandomScenarioOptions& options);
+
+// Recorded pedestrians: the person `follow_id` of `dataset` is followed (from their first to
+// their last observation), everyone else is replayed around them; the robot starts 1 m behind.
+struct PedestrianDataset;
+std::optional<Scenario> recorded_scenario(const PedestrianDataset& dataset, int follow_id,
+                                          std::string* error);
+
+}  // namespace sim

@@ -1,0 +1,47 @@
+#pragma once
+// A walked path as timed samples (world frame), interpolated: how the simulated person moves
+// (a scripted waypoint walk, or one person of a recorded dataset) and how recorded pedestrians
+// are replayed. Before its first sample an agent stands at the first one; after its last, at
+// the last one.
+#include <vector>
+
+#include "core/geometry/pose2.hpp"
+
+namespace sim {
+
+struct TimedPose {
+  double t_s = 0;
+  core::Pose2 pose;  // heading = walking direction
+};
+
+class Trajectory {
+ public:
+  Trajectory() = default;
+  explicit Trajectory(std::vector<TimedPose> samples) : samples_(std::move(samples)) {}
+
+  [[nodiscard]] core::Pose2 pose_at(double t_s) const;
+  [[nodiscard]] core::Point2 velocity_at(double t_s) const;  // m/s, world frame
+  [[nodiscard]] double start_s() const { return samples_.empty() ? 0.0 : samples_.front().t_s; }
+  [[nodiscard]] double end_s() const { return samples_.empty() ? 0.0 : samples_.back().t_s; }
+  [[nodiscard]] bool empty() const { return samples_.empty(); }
+  [[nodiscard]] const std::vector<TimedPose>& samples() const { return samples_; }
+
+ private:
+  std::vector<TimedPose> samples_;
+};
+
+// A waypoint walk: legs at their own speeds, optional pauses, sudden turns at the corners (the
+// walker faces the next leg at once, as people do at a corner).
+struct Waypoint {
+  core::Point2 p;
+  double speed_mps = 1.0;  // on the leg that ends here
+  double pause_s = 0;      // standing here before the next leg
+};
+// Sampled every `step_s`, starting at `start_s` (standing at the first waypoint until then).
+Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s = 0.0,
+                double step_s = 0.05);
+
+// Headings of position samples from their motion (kept while standing).
+void set_headings_from_motion(std::vector<TimedPose>& samples);
+
+}  // namespace sim

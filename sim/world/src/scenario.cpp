@@ -1,0 +1,225 @@
+#include "sim/scenario.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include "sim/pedestrian_dataset.hpp"
+
+namespace sim {
+
+namespace {
+// Every built-in person starts walking here, after the daemon armed (costmap, tracker, base).
+constexpr double kStartDelayS = 4.0;
+constexpr double kTailS = 3.0;  // standing at the end, so the run ends at rest
+
+Scenario base_scenario(const char* name, const char* description,
+                       const std::vector<Waypoint>& walk_points) {
+  Scenario s;
+  s.name = name;
+  s.description = description;
+  s.person = walk(walk_points, kStartDelayS);
+  const core::Pose2 p0 = s.person.pose_at(0.0);
+  s.robot_start = p0 * core::Pose2{-1.0, 0.0, 0.0};  // 1 m behind the person, same heading
+  s.duration_s = s.person.end_s() + kTailS;
+  return s;
+}
+
+Pedestrian walker(Point2 from, Point2 to, double speed) {
+  Pedestrian p;
+  p.position = from;
+  p.desired_speed_mps = speed;
+  p.goals = {to};
+  return p;
+}
+
+Scenario open_space() {
+  return base_scenario("open", "open space, rectangular walk with sharp turns",
+                       {{{0, 0}}, {{8, 0}, 1.0}, {{8, 6}, 1.0}, {{0, 6}, 1.0}, {{0, 0.5}, 1.0}});
+}
+
+Scenario static_obstacle() {
+  Scenario s = base_scenario("static_obstacle", "a static obstacle on one side of the walk",
+                             {{{0, 0}}, {{16, 0}, 1.0}});
+  // The robot starts behind-right; the obstacle on the right forces it to another side.
+  s.robot_start = core::Pose2{-0.8, -0.6, 0.0};
+  s.world.add_box({6.0, -3.0}, {10.0, -1.0});
+  return s;
+}
+
+Scenario pedestrian_front_right() {
+  Scenario s = base_scenario("pedestrian_front_right", "a pedestrian approaching from the front-right",
+                             {{{0, 0}}, {{16, 0}, 1.0}});
+  s.pedestrians.push_back(walker({16.0, -3.0}, {-4.0, 1.0}, 1.2));
+  return s;
+}
+
+Scenario corridor() {
+  Scenario s = base_scenario("corridor", "a corridor narrowing on both sides",
+                             {{{0, 0}}, {{18, 0}, 1.0}});
+  // 5 m wide, narrowing to 2.4 m between x = 7 and 12, then wide again.
+  for (double side : {-1.0, 1.0}) {
+    s.world.add_wall({-3.0, 2.5 * side}, {5.0, 2.5 * side});
+    s.world.add_wall({5.0, 2.5 * side}, {7.0, 1.2 * side});
+    s.world.add_wall({7.0, 1.2 * side}, {12.0, 1.2 * side});
+    s.world.add_wall({12.0, 1.2 * side}, {14.0, 2.5 * side});
+    s.world.add_wall({14.0, 2.5 * side}, {21.0, 2.5 * side});
+  }
+  return s;
+}
+
+Scenario doorway() {
+  Scenario s = base_scenario("doorway", "a doorway with a sudden turn behind it",
+                             {{{0, 0}}, {{9.5, 0}, 1.0}, {{9.5, 6}, 1.0}});
+  // A wall across the walk at x = 8 with a 2 m door; the person turns left right behind it.
+  s.world.add_wall({8.0, -6.0}, {8.0, -1.0});
+  s.world.add_wall({8.0, 1.0}, {8.0, 8.0});
+  return s;
+}
+
+Scenario crossing() {
+  Scenario s = base_scenario("crossing", "three pedestrians crossing between robot and person",
+                             {{{0, 0}}, {{16, 0}, 1.0}});
+  // Each crosses the walk 0.6 m behind the person (between the person and the robot).
+  for (double x : {5.0, 8.0, 11.0}) {
+    const double t_cross = kStartDelayS + (x + 0.6) / 1.0;
+    const double speed = 1.2;
+    const double y0 = -speed * t_cross;
+    s.pedestrians.push_back(walker({x, y0}, {x, 8.0}, speed));
+  }
+  return s;
+}
+
+double uniform(std::mt19937& rng, double a, double b) {
+  return std::uniform_real_distribution<double>(a, b)(rng);
+}
+
+}  // namespace
+
+const std::vector<ScenarioInfo>& builtin_scenarios() {
+  static const std::vector<ScenarioInfo> kList{
+      {"open", "1: open space, rectangular walk with sharp turns"},
+      {"static_obstacle", "2: a static obstacle on one side"},
+      {"pedestrian_front_right", "3: a pedestrian approaching from the front-right"},
+      {"corridor", "4: a corridor narrowing on both sides"},
+      {"doorway", "5: a doorway with a sudden turn behind it"},
+      {"crossing", "6: three pedestrians crossing between robot and person"},
+      {"random", "7: random static obstacles + 10 pedestrians, 0.7-1.5 m/s (seeded)"},
+  };
+  return kList;
+}
+
+std::optional<Scenario> make_scenario(const std::string& name, uint32_t seed) {
+  if (name == "open" || name == "1") return open_space();
+  if (name == "static_obstacle" || name == "2") return static_obstacle();
+  if (name == "pedestrian_front_right" || name == "3") return pedestrian_front_right();
+  if (name == "corridor" || name == "4") return corridor();
+  if (name == "doorway" || name == "5") return doorway();
+  if (name == "crossing" || name == "6") return crossing();
+  if (name == "random" || name == "7") return random_scenario(seed, {});
+  return std::nullopt;
+}
+
+Scenario random_scenario(uint32_t seed, const RandomScenarioOptions& o) {
+  std::mt19937 rng(seed);
+  const double speed = uniform(rng, o.speed_min_mps, o.speed_max_mps);
+  // The person's walk: legs of 4-8 m with turns up to +-100 degrees, inside a 24 m square.
+  std::vector<Waypoint> pts{{{0, 0}}};
+  double heading = 0;
+  double t = kStartDelayS;
+  core::Point2 p{0, 0};
+  while (t < o.duration_s - kTailS) {
+    for (int attempt = 0; attempt < 20; ++attempt) {
+      const double turn = uniform(rng, -1.75, 1.75);
+      const double len = uniform(rng, 4.0, 8.0);
+      const core::Point2 q{p.x_m + len * std::cos(heading + turn),
+                           p.y_m + len * std::sin(heading + turn)};
+      if (std::abs(q.x_m) < 12 && std::abs(q.y_m) < 12) {
+        heading += turn;
+        t += len / speed;
+        p = q;
+        pts.push_back({q, speed});
+        break;
+      }
+      heading += std::numbers::pi / 2;  // facing a boundary: try around
+    }
+  }
+  Scenario s = base_scenario("random", "random static obstacles and pedestrians", pts);
+  s.name = fmt::format("random-{}", seed);
+  s.duration_s = std::min(s.duration_s, o.duration_s);
+  // Static obstacles: circles and boxes at least 1.6 m from the person's walk and the start.
+  auto clear_of_walk = [&](core::Point2 c, double r) {
+    for (const TimedPose& tp : s.person.samples()) {
+      if (std::hypot(tp.pose.x_m - c.x_m, tp.pose.y_m - c.y_m) < r + 1.6) return false;
+    }
+    return std::hypot(s.robot_start.x_m - c.x_m, s.robot_start.y_m - c.y_m) > r + 1.5;
+  };
+  for (int i = 0, tries = 0; i < o.obstacles && tries < 2000; ++tries) {
+    const core::Point2 c{uniform(rng, -13, 13), uniform(rng, -13, 13)};
+    const double r = uniform(rng, 0.3, 0.8);
+    if (!clear_of_walk(c, r)) continue;
+    if (rng() % 2 == 0) {
+      s.world.add_circle(c, r);
+    } else {
+      s.world.add_box({c.x_m - r, c.y_m - r}, {c.x_m + r, c.y_m + r});
+    }
+    ++i;
+  }
+  // Pedestrians: walking back and forth between two random points of the area.
+  std::normal_distribution<double> desired(1.2, 0.2);
+  for (int i = 0; i < o.pedestrians; ++i) {
+    Pedestrian ped;
+    do {
+      ped.position = {uniform(rng, -12, 12), uniform(rng, -12, 12)};
+    } while (std::hypot(ped.position.x_m, ped.position.y_m) < 3.0 ||
+             s.world.distance(ped.position) < 0.6);
+    ped.goals = {{uniform(rng, -12, 12), uniform(rng, -12, 12)}, ped.position};
+    ped.loop = true;
+    ped.desired_speed_mps = std::clamp(desired(rng), 0.6, 1.8);
+    ped.radius_m = uniform(rng, 0.2, 0.35);
+    s.pedestrians.push_back(ped);
+  }
+  return s;
+}
+
+std::optional<Scenario> recorded_scenario(const PedestrianDataset& dataset, int follow_id,
+                                          std::string* error) {
+  const auto it = dataset.people.find(follow_id);
+  if (it == dataset.people.end()) {
+    if (error != nullptr) *error = fmt::format("no person with id {} in the file", follow_id);
+    return std::nullopt;
+  }
+  const Trajectory& followed = it->second;
+  if (followed.samples().size() < 2) {
+    if (error != nullptr) *error = fmt::format("person {} is observed only once", follow_id);
+    return std::nullopt;
+  }
+  // Time shifted so the followed person appears at kStartDelayS (the daemon arms meanwhile).
+  const double shift = kStartDelayS - followed.start_s();
+  auto shifted = [&](const Trajectory& tr) {
+    std::vector<TimedPose> out = tr.samples();
+    for (TimedPose& s : out)
+      s.t_s += shift;
+    return Trajectory(std::move(out));
+  };
+  Scenario s;
+  s.name = fmt::format("recorded-{}", follow_id);
+  s.description = fmt::format("recorded pedestrians, following person {}", follow_id);
+  s.person = shifted(followed);
+  const core::Pose2 p0 = s.person.pose_at(0.0);
+  s.robot_start = p0 * core::Pose2{-1.0, 0.0, 0.0};
+  for (const auto& [id, tr] : dataset.people) {
+    if (id == follow_id) continue;
+    const Trajectory moved = shifted(tr);
+    // Only those who are around while the followed person walks.
+    if (moved.end_s() < kStartDelayS || moved.start_s() > s.person.end_s()) continue;
+    s.replayed.push_back(moved);
+  }
+  s.duration_s = s.person.end_s() + kTailS;
+  return s;
+}
+
+}  // namespace sim

@@ -1,0 +1,238 @@
+#include "sim/sim_world.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+
+namespace sim {
+
+namespace {
+Eigen::Matrix3d rpy(const std::array<double, 3>& a) {
+  return (Eigen::AngleAxisd(a[2], Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(a[1], Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(a[0], Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
+// The daemon's end of the lidar queue (the world keeps pushing into it).
+class SharedDatagramSource final : public hal::DatagramSource {
+ public:
+  explicit SharedDatagramSource(std::shared_ptr<hal::DatagramQueue> q) : q_(std::move(q)) {}
+  size_t drain(size_t max, hal::Nanos now,
+               const std::function<void(const hal::UdpDatagram&)>& on) override {
+    return q_->drain(max, now, on);
+  }
+  [[nodiscard]] hal::UdpStats stats() const override { return q_->stats(); }
+
+ private:
+  std::shared_ptr<hal::DatagramQueue> q_;
+};
+
+std::string next_network_name() {
+  static std::atomic<uint64_t> n{0};
+  return "simworld-" + std::to_string(n.fetch_add(1));
+}
+
+constexpr double kReplayedRadiusM = 0.25;  // recorded people: body radius
+
+// Distance from a point to an axis-aligned box (0 inside).
+double box_distance(double x, double y, double x0, double x1, double y0, double y1) {
+  const double dx = std::max({x0 - x, 0.0, x - x1});
+  const double dy = std::max({y0 - y, 0.0, y - y1});
+  return std::hypot(dx, dy);
+}
+}  // namespace
+
+SimWorld::SimWorld(Scenario scenario, const SimWorldConfig& config, hal::Clock& clock)
+    : scenario_(std::move(scenario)),
+      config_(config),
+      clock_(clock),
+      can_network_(next_network_name()),
+      base_bus_(std::make_unique<hal::VirtualCanBus>(can_network_, clock)),
+      daemon_bus_(std::make_unique<hal::VirtualCanBus>(can_network_, clock)),
+      base_(std::make_unique<SimScoutMini>(*base_bus_, config.base)),
+      tracker_(config.tracker),
+      lidar_(config.lidar),
+      lidar_queue_(std::make_shared<hal::DatagramQueue>()),
+      r_base_source_(rpy(config.tracker_extrinsics.source_rpy_rad)),
+      t_base_source_(config.tracker_extrinsics.source_xyz_m[0],
+                     config.tracker_extrinsics.source_xyz_m[1],
+                     config.tracker_extrinsics.source_xyz_m[2]),
+      r_body_sensor_(rpy(config.tracker_extrinsics.sensor_in_body_rpy_rad)) {
+  for (const Pedestrian& p : scenario_.pedestrians)
+    crowd_.add(p);
+  person_ = scenario_.person.pose_at(0.0);
+  prev_robot_ = scenario_.robot_start;
+}
+
+SimWorld::~SimWorld() = default;
+
+std::unique_ptr<hal::CanBus> SimWorld::take_base_bus() {
+  return std::move(daemon_bus_);
+}
+
+std::unique_ptr<hal::VirtualCanBus> SimWorld::open_can_sniffer() {
+  return std::make_unique<hal::VirtualCanBus>(can_network_, clock_);
+}
+
+std::unique_ptr<amfitrack::PacketLink> SimWorld::take_tracker_link() {
+  return tracker_.host_link();
+}
+
+std::unique_ptr<hal::DatagramSource> SimWorld::take_lidar_source() {
+  return std::make_unique<SharedDatagramSource>(lidar_queue_);
+}
+
+core::Pose2 SimWorld::robot_pose() const {
+  const auto& p = base_->pose();
+  return scenario_.robot_start * core::Pose2{p.x_m, p.y_m, p.theta_rad};
+}
+
+std::vector<Point2> SimWorld::pedestrian_positions() const {
+  std::vector<Point2> out;
+  for (const Pedestrian& p : crowd_.people())
+    out.push_back(p.position);
+  for (const Trajectory& r : scenario_.replayed) {
+    if (t_s_ >= r.start_s() && t_s_ <= r.end_s()) {
+      const auto q = r.pose_at(t_s_);
+      out.push_back({q.x_m, q.y_m});
+    }
+  }
+  return out;
+}
+
+core::Pose2 SimWorld::robot_at(hal::Nanos t) const {
+  const core::Pose2 now = robot_pose();
+  if (last_step_ <= prev_robot_time_) return now;
+  const double s = std::clamp(static_cast<double>((t - prev_robot_time_).count()) /
+                                  static_cast<double>((last_step_ - prev_robot_time_).count()),
+                              0.0, 1.0);
+  return core::interpolate(prev_robot_, now, s);
+}
+
+void SimWorld::advance(double t_s) {
+  const double dt = t_s - t_s_;
+  person_ = scenario_.person.pose_at(t_s);
+  person_velocity_ = scenario_.person.velocity_at(t_s);
+  if (dt > 0) {
+    const core::Pose2 robot = robot_pose();
+    const auto& v = base_->velocity();
+    const Point2 v_world = robot.rotate({v.vx_mps, v.vy_mps});
+    bodies_.clear();
+    bodies_.push_back({{person_.x_m, person_.y_m}, person_velocity_, scenario_.person_radius_m});
+    bodies_.push_back({{robot.x_m, robot.y_m}, v_world, config_.robot_avoid_radius_m});
+    for (const Trajectory& r : scenario_.replayed) {
+      if (t_s < r.start_s() || t_s > r.end_s()) continue;
+      const auto q = r.pose_at(t_s);
+      bodies_.push_back({{q.x_m, q.y_m}, r.velocity_at(t_s), kReplayedRadiusM});
+    }
+    crowd_.step(dt, scenario_.world, bodies_);
+  }
+  t_s_ = t_s;
+}
+
+void SimWorld::update_tracker_pose() {
+  // The person in base_link, then in the source's frame: what the sensor reports.
+  const core::Pose2 rel = robot_pose().inverse() * person_;
+  const Eigen::Vector3d p_base(rel.x_m, rel.y_m, config_.sensor_height_m);
+  const Eigen::Vector3d p_source = r_base_source_.transpose() * (p_base - t_base_source_);
+  const Eigen::Matrix3d r_base_body =
+      Eigen::AngleAxisd(rel.theta_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Quaterniond q(r_base_source_.transpose() * r_base_body * r_body_sensor_);
+  tracker_.set_sensor_pose({p_source.x(), p_source.y(), p_source.z()},
+                           {q.x(), q.y(), q.z(), q.w()});
+}
+
+void SimWorld::step(hal::Nanos now) {
+  if (!started_) {
+    started_ = true;
+    last_step_ = now;
+    prev_robot_time_ = now;
+    advance(0.0);
+  }
+  const hal::Nanos step(static_cast<int64_t>(config_.step_s * 1e9));
+  while (last_step_ + step <= now) {
+    prev_robot_ = robot_pose();
+    prev_robot_time_ = last_step_;
+    last_step_ += step;
+    advance(t_s_ + config_.step_s);
+    base_->step(last_step_);
+    update_tracker_pose();
+    tracker_.step(last_step_);
+    cylinders_.clear();
+    cylinders_.push_back({{person_.x_m, person_.y_m}, scenario_.person_radius_m, 1.75});
+    for (const Pedestrian& p : crowd_.people())
+      cylinders_.push_back({p.position, p.radius_m, 1.75});
+    for (const Trajectory& r : scenario_.replayed) {
+      if (t_s_ < r.start_s() || t_s_ > r.end_s()) continue;
+      const auto q = r.pose_at(t_s_);
+      cylinders_.push_back({{q.x_m, q.y_m}, kReplayedRadiusM, 1.75});
+    }
+    lidar_.step(last_step_, scenario_.world, cylinders_,
+                [this](hal::Nanos t) { return robot_at(t); },
+                [this](std::span<const uint8_t> bytes, hal::Nanos arrival) {
+                  if (!lidar_silent_) lidar_queue_->push(bytes, arrival);
+                });
+  }
+}
+
+double SimWorld::footprint_distance(const Point2& p) const {
+  const core::Point2 q = robot_pose().inverse().apply(p);
+  return box_distance(q.x_m, q.y_m, config_.footprint_x_min_m, config_.footprint_x_max_m,
+                      config_.footprint_y_min_m, config_.footprint_y_max_m);
+}
+
+double SimWorld::footprint_clearance_static() const {
+  // Exact box-to-segment and box-to-circle distances in base_link.
+  const core::Pose2 inv = robot_pose().inverse();
+  const double x0 = config_.footprint_x_min_m, x1 = config_.footprint_x_max_m;
+  const double y0 = config_.footprint_y_min_m, y1 = config_.footprint_y_max_m;
+  const std::array<Point2, 4> corners{Point2{x0, y0}, Point2{x1, y0}, Point2{x1, y1},
+                                      Point2{x0, y1}};
+  double best = std::numeric_limits<double>::infinity();
+  for (const Segment& w : scenario_.world.segments) {
+    const Segment s{inv.apply(w.a), inv.apply(w.b)};
+    // A segment that crosses the box (Liang-Barsky clip leaves a piece) touches it.
+    double t0 = 0, t1 = 1;
+    const double dx = s.b.x_m - s.a.x_m, dy = s.b.y_m - s.a.y_m;
+    bool inside = true;
+    for (const auto& [p, q] : std::array<std::pair<double, double>, 4>{
+             {{-dx, s.a.x_m - x0}, {dx, x1 - s.a.x_m}, {-dy, s.a.y_m - y0}, {dy, y1 - s.a.y_m}}}) {
+      if (p == 0) {
+        if (q < 0) inside = false;
+      } else {
+        const double r = q / p;
+        if (p < 0) t0 = std::max(t0, r);
+        else t1 = std::min(t1, r);
+      }
+    }
+    if (inside && t0 <= t1) return 0.0;
+    best = std::min({best, box_distance(s.a.x_m, s.a.y_m, x0, x1, y0, y1),
+                     box_distance(s.b.x_m, s.b.y_m, x0, x1, y0, y1)});
+    for (const Point2& c : corners) {
+      const Point2 q = closest_on_segment(s, c);
+      best = std::min(best, std::hypot(q.x_m - c.x_m, q.y_m - c.y_m));
+    }
+  }
+  for (const Circle& c : scenario_.world.circles) {
+    best = std::min(best, std::max(footprint_distance(c.center) - c.radius_m, 0.0));
+  }
+  return best;
+}
+
+double SimWorld::footprint_clearance_people() const {
+  double best = footprint_distance({person_.x_m, person_.y_m}) - scenario_.person_radius_m;
+  for (const Pedestrian& p : crowd_.people())
+    best = std::min(best, footprint_distance(p.position) - p.radius_m);
+  for (const Trajectory& r : scenario_.replayed) {
+    if (t_s_ < r.start_s() || t_s_ > r.end_s()) continue;
+    const auto q = r.pose_at(t_s_);
+    best = std::min(best, footprint_distance({q.x_m, q.y_m}) - kReplayedRadiusM);
+  }
+  return std::max(best, 0.0);
+}
+
+}  // namespace sim

@@ -1,0 +1,238 @@
+// The whole product in the simulated world, on the simulated clock: the real task table, the real
+// drivers decoding the devices' real bytes (Scout Mini CAN frames, Amfiprot 0x1A frames, VLP-16
+// packets ray cast from the world), the supervisor gating every command.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <algorithm>
+#include <numeric>
+
+#include "firmware/config/config_loader.hpp"
+#include "firmware/daemon.hpp"
+#include "scout_mini/scout_codec.hpp"
+#include "sim/sim_run.hpp"
+
+using sim::SimRunOptions;
+
+namespace {
+firmware::DaemonConfig defaults() {
+  return *firmware::load_default_config().config;
+}
+
+SimRunOptions scenario(const std::string& name) {
+  SimRunOptions o;
+  o.config = defaults();
+  o.scenario = *sim::make_scenario(name);
+  return o;
+}
+
+void print(const std::string& name, const sim::SimRunResult& r) {
+  const auto& m = r.metrics;
+  std::printf(
+      "%s: %s %s | UT %.2f s, in ellipse %.2f s, active %.1f/%.1f s, rmse %.3f %.3f %.3f, "
+      "min static %.2f m people %.2f m, person %.2f..%.2f m (mean %.2f), stops %llu, wall %.1f s\n",
+      name.c_str(), m.success ? "SUCCESS" : "FAIL", m.failure.c_str(), m.uncomfortable_s,
+      m.inside_ellipse_s, m.active_s, m.duration_s, m.rmse_ex_m, m.rmse_ey_m, m.rmse_etheta_rad,
+      m.min_static_clearance_m, m.min_people_clearance_m, m.min_person_distance_m,
+      m.max_person_distance_m, m.mean_person_distance_m,
+      static_cast<unsigned long long>(m.stops), r.wall_s);
+}
+
+bool is_active(const firmware::Daemon& d) {
+  const auto s = d.safety().read();
+  return s && s->value.state == core::SafetyState::kActive;
+}
+
+double speed(sim::SimWorld& w) {
+  const auto& v = w.base().velocity();
+  return std::hypot(v.vx_mps, v.vy_mps) + std::abs(v.wz_radps);
+}
+}  // namespace
+
+// ---- scenarios 1-6 of reference/evaluation.md: success = no collision, never lost ------------
+
+class PaperScenario : public testing::TestWithParam<const char*> {};
+
+TEST_P(PaperScenario, AccompaniesThePersonWithoutCollision) {
+  const auto r = sim::run_simulation(scenario(GetParam()));
+  print(GetParam(), r);
+  EXPECT_FALSE(r.metrics.collision) << r.metrics.failure;
+  EXPECT_TRUE(r.metrics.success) << r.metrics.failure;
+  EXPECT_GT(r.metrics.active_s, 0.7 * (r.metrics.duration_s - 4.0)) << "moving most of the run";
+  EXPECT_LT(r.metrics.uncomfortable_s, 1.0) << "hardly ever in the intimate zone";
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenarios1To6, PaperScenario,
+                         testing::Values("open", "static_obstacle", "pedestrian_front_right",
+                                         "corridor", "doorway", "crossing"));
+
+TEST(ClosedLoop, OpenSpaceKeepsThePersonWithinTheInteractionSpace) {
+  const auto r = sim::run_simulation(scenario("open"));
+  const auto& m = r.metrics;
+  EXPECT_GT(m.tracking_s, 25.0);
+  // Around the ellipse (a = 1.0, b = 0.7 m) the whole walk, sharp turns included.
+  EXPECT_GT(m.mean_person_distance_m, 0.7);
+  EXPECT_LT(m.mean_person_distance_m, 1.4);
+  EXPECT_LT(m.longest_far_s, 2.0) << "never more than 2 m away for long";
+  EXPECT_LT(m.rmse_ex_m, 0.5);
+  EXPECT_LT(m.rmse_ey_m, 0.5);
+}
+
+TEST(ClosedLoop, SwitchesSidesAroundAStaticObstacle) {
+  // The robot starts behind-right; the box on the person's right (x 6..10) leaves no free point
+  // there, so the chosen point moves to another side while passing it.
+  std::array<double, 8> before{}, passing{};
+  auto o = scenario("static_obstacle");
+  o.script = [&](double, sim::SimWorld& w, firmware::Daemon& d) {
+    const auto v = sim::daemon_view(d, w.robot_pose());
+    if (!v.active || v.side < 0) return;
+    const double x = w.person_pose().x_m;
+    if (x > 1.0 && x < 5.0) before[static_cast<size_t>(v.side)] += 0.005;
+    if (x > 7.0 && x < 9.5) passing[static_cast<size_t>(v.side)] += 0.005;
+  };
+  const auto r = sim::run_simulation(o);
+  print("static_obstacle", r);
+  EXPECT_FALSE(r.metrics.collision) << r.metrics.failure;
+  const double right_before = before[5] + before[6] + before[7];
+  const double right_passing = passing[5] + passing[6] + passing[7];
+  EXPECT_GT(right_before, 0.5 * std::accumulate(before.begin(), before.end(), 0.0))
+      << "on the right before the obstacle";
+  EXPECT_LT(right_passing, 0.1 * std::accumulate(passing.begin(), passing.end(), 0.0))
+      << "not on the right while passing it";
+}
+
+// ---- the watchdog: tracker confidence, silence, lidar, base -----------------------------------
+
+TEST(ClosedLoop, LowTrackerConfidenceStopsWithinTheBoundAndResumesAfterTheHysteresis) {
+  // A slow walk (0.5 m/s), so that the person is still within reach (supervisor.
+  // person_max_distance_m) when the robot may move again.
+  auto o = scenario("open");
+  o.scenario.person = sim::walk({{{0, 0}}, {{20, 0}, 0.5}}, 4.0);
+  o.duration_s = 14.0;
+  const double drop_at = 8.0, good_again = 9.0;
+  double stopped_at = -1, resumed_at = -1;
+  o.script = [&](double t, sim::SimWorld& w, firmware::Daemon& d) {
+    if (std::abs(t - drop_at) < 1e-9) w.tracker().set_quality(40);  // below quality_bad_below
+    if (std::abs(t - good_again) < 1e-9) w.tracker().set_quality(230);
+    if (t > drop_at && stopped_at < 0 && speed(w) == 0.0) stopped_at = t;
+    if (t > good_again && resumed_at < 0 && is_active(d)) resumed_at = t;
+    if (t > drop_at && t < good_again) {
+      const auto s = d.safety().read();
+      if (t > drop_at + 0.1) {
+        EXPECT_EQ(s->value.reason, core::Reason::kTrackerConfidenceLow) << "t=" << t;
+      }
+    }
+  };
+  std::string final_status;
+  auto observe = o.script;
+  o.script = [&](double t, sim::SimWorld& w, firmware::Daemon& d) {
+    observe(t, w, d);
+    final_status = d.status_line();
+  };
+  const auto r = sim::run_simulation(o);
+  const auto cfg = defaults();
+  ASSERT_GT(stopped_at, 0) << "stopped";
+  // The gate needs the frames, the supervisor one tick, the stop at most stop_max_time_ms.
+  EXPECT_LE(stopped_at - drop_at, static_cast<double>(cfg.supervisor.stop_max_time_ms) / 1000.0 + 0.1);
+  ASSERT_GT(resumed_at, 0) << "resumed; " << final_status;
+  EXPECT_GE(resumed_at - good_again, static_cast<double>(cfg.supervisor.tracker_confidence_recover_ms) / 1000.0)
+      << "not before the hysteresis";
+  EXPECT_LE(resumed_at - good_again, static_cast<double>(cfg.supervisor.tracker_confidence_recover_ms) / 1000.0 + 0.5);
+  EXPECT_FALSE(r.metrics.collision);
+}
+
+struct Fault {
+  const char* name;
+  std::function<void(sim::SimWorld&, bool on)> inject;
+  core::Reason reason;
+};
+
+class InputFault : public testing::TestWithParam<Fault> {};
+
+TEST_P(InputFault, StopsTheRobotAndNamesTheReason) {
+  const Fault& f = GetParam();
+  auto o = scenario("open");
+  o.duration_s = 10.0;
+  const double at = 7.0;  // walking by then
+  bool moving_before = false;
+  double stopped_at = -1;
+  bool reason_seen = false;
+  o.script = [&](double t, sim::SimWorld& w, firmware::Daemon& d) {
+    if (t < at && speed(w) > 0.3) moving_before = true;
+    if (std::abs(t - at) < 1e-9) f.inject(w, true);
+    if (t > at && stopped_at < 0 && speed(w) == 0.0) stopped_at = t;
+    if (t > at + 0.5) {
+      const auto s = d.safety().read();
+      if ((s->value.active_mask >> core::reason_index(f.reason) & 1U) != 0) reason_seen = true;
+      EXPECT_FALSE(s->value.motion_allowed) << f.name << " t=" << t;
+      const auto c = d.command().read();
+      if (t > at + 2.0) {
+        EXPECT_TRUE(c->value.is_zero()) << f.name << " t=" << t;
+      }
+    }
+  };
+  sim::run_simulation(o);
+  EXPECT_TRUE(moving_before) << "the robot was moving before the fault";
+  EXPECT_TRUE(reason_seen) << core::reason_name(f.reason);
+  ASSERT_GT(stopped_at, 0) << "stopped";
+  EXPECT_LE(stopped_at - at, 2.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Watchdog, InputFault,
+    testing::Values(
+        Fault{"tracker_silent", [](sim::SimWorld& w, bool on) { w.tracker().set_silent(on); },
+              core::Reason::kTrackerSilent},
+        Fault{"lidar_silent", [](sim::SimWorld& w, bool on) { w.set_lidar_silent(on); },
+              core::Reason::kLidarSilent},
+        Fault{"base_estop", [](sim::SimWorld& w, bool on) { w.base().set_estop(on); },
+              core::Reason::kBaseEstop},
+        Fault{"rc_takeover", [](sim::SimWorld& w, bool on) { w.base().set_rc_takeover(on); },
+              core::Reason::kRcOverride},
+        Fault{"base_fault", [](sim::SimWorld& w, bool) { w.base().inject_motor_fault(1); },
+              core::Reason::kBaseFault}),
+    [](const testing::TestParamInfo<Fault>& i) { return std::string(i.param.name); });
+
+TEST(ClosedLoop, ShutdownCommandsZeroAndTheBaseConfirmsStandstill) {
+  auto o = scenario("open");
+  o.duration_s = 9.5;
+  bool complete = false;
+  double complete_at = -1;
+  o.script = [&](double t, sim::SimWorld& w, firmware::Daemon& d) {
+    if (std::abs(t - 7.0) < 1e-9) {
+      EXPECT_GT(speed(w), 0.3) << "moving when SIGTERM arrives";
+      d.request_shutdown();
+    }
+    if (t > 7.0 && !complete && d.shutdown_complete()) {
+      complete = true;
+      complete_at = t;
+      EXPECT_EQ(speed(w), 0.0) << "standing when the daemon may exit";
+    }
+  };
+  o.capture_can = true;
+  const auto r = sim::run_simulation(o);
+  ASSERT_TRUE(complete);
+  EXPECT_LE(complete_at - 7.0, static_cast<double>(defaults().supervisor.stop_max_time_ms) / 1000.0 + 0.2);
+  // The last motion command on the bus is zero.
+  for (auto it = r.can_out.rbegin(); it != r.can_out.rend(); ++it) {
+    if (it->id == scout_mini::id::kMotionCommand) {
+      EXPECT_TRUE(std::all_of(it->data.begin(), it->data.begin() + 6, [](uint8_t b) { return b == 0; }));
+      break;
+    }
+  }
+}
+
+TEST(ClosedLoop, SameSeedSameCanOutputBitForBit) {
+  auto o = scenario("crossing");
+  o.duration_s = 12.0;
+  o.capture_can = true;
+  const auto a = sim::run_simulation(o);
+  const auto b = sim::run_simulation(o);
+  ASSERT_GT(a.can_out.size(), 1000U);
+  ASSERT_EQ(a.can_out.size(), b.can_out.size());
+  for (size_t i = 0; i < a.can_out.size(); ++i) {
+    ASSERT_EQ(a.can_out[i].id, b.can_out[i].id) << i;
+    ASSERT_EQ(a.can_out[i].data, b.can_out[i].data) << "frame " << i;
+  }
+}
