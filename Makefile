@@ -1,5 +1,5 @@
 # Thin wrappers over CMake presets. The two commands of the README:
-#   make run    install dependencies, build, run companiond (built-in defaults / simulated world)
+#   make run    install dependencies, build, run companiond on the simulated world (SCENARIO=...)
 #   make test   install dependencies, build, run every test (ThreadSanitizer pass included)
 .PHONY: run test deps build bench fuzz format tidy clean
 
@@ -16,10 +16,13 @@ build: deps
 	@cmake --preset dev > /dev/null
 	@cmake --build --preset dev -j $(JOBS)
 
+SCENARIO ?= static_obstacle
 run: deps
 	@cmake --preset dev > /dev/null
 	@cmake --build --preset dev -j $(JOBS) --target companiond
-	./build/dev/firmware/companiond --config config/companiond.yaml --log-sink console
+	@mkdir -p build/run
+	./build/dev/firmware/companiond --config config/sim.yaml --scenario $(SCENARIO) --live \
+	  --log-sink console --status-file build/run/status.json --report build/run/report
 
 test: build
 	@cmake --preset tsan > /dev/null

@@ -7,6 +7,9 @@
 #include <csignal>
 #include <cstdio>
 #include <iostream>
+#include <optional>
+
+#include <unistd.h>
 
 #include "amfitrack/open_link.hpp"
 #include "firmware/config/config_loader.hpp"
@@ -18,6 +21,8 @@
 #include "hal/net/udp_socket.hpp"
 #include "hal/realtime.hpp"
 #include "hal/sd_notify.hpp"
+#include "sim/sim_run.hpp"
+#include "sim_mode.hpp"
 
 namespace {
 
@@ -44,6 +49,10 @@ int run(int argc, char** argv) {
   bool reference = false;
   double duration_s = 0.0;
   std::string sink_name = "auto";
+  std::string status_file;
+  bool live = false;
+  bool list_scenarios = false;
+  companiond::SimOptions sim_opts;
   app.add_option("-c,--config", config_path, "YAML configuration (keys: config/README.md)");
   app.add_option("--check-config", check_path, "validate FILE, print the verdict and exit");
   app.add_flag("--print-config", print, "print the effective configuration and exit");
@@ -52,7 +61,31 @@ int run(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--log-sink", sink_name, "auto (journald under systemd), console, journald")
       ->check(CLI::IsMember({"auto", "console", "journald"}));
+  app.add_option("--status-file", status_file,
+                 "write the machine-readable status (JSON) here every second, atomically");
+  app.add_flag("--live", live, "print a one-line live status every second on stdout");
+  auto* simg = app.add_option_group("simulation", "with devices 'sim' (config/sim.yaml)");
+  simg->add_option("--scenario", sim_opts.scenario, "built-in scenario (--list-scenarios)");
+  simg->add_flag("--list-scenarios", list_scenarios, "list the built-in scenarios and exit");
+  simg->add_option("--seed", sim_opts.seed, "seed of the world and the controller");
+  simg->add_option("--pedestrians", sim_opts.pedestrians_file,
+                   "recorded pedestrians 'frame id x y' to replay (instead of --scenario)");
+  simg->add_option("--frame-period", sim_opts.frame_period_s,
+                   "seconds between consecutive frame values in --pedestrians")
+      ->check(CLI::PositiveNumber);
+  simg->add_option("--follow", sim_opts.follow_id,
+                   "id of the recorded person to accompany (default: observed longest)");
+  simg->add_flag("--sim-clock", sim_opts.sim_clock,
+                 "run on the simulated clock (deterministic, faster than real time)");
+  simg->add_option("--report", sim_opts.report_dir,
+                   "write the run report here at the end (report.md, trajectory.svg, ...)");
   CLI11_PARSE(app, argc, argv);
+
+  if (list_scenarios) {
+    for (const auto& s : sim::builtin_scenarios())
+      std::cout << s.name << "  " << s.description << "\n";
+    return 0;
+  }
 
   if (reference) {
     std::cout << firmware::config_reference_markdown();
@@ -106,9 +139,42 @@ int run(int argc, char** argv) {
   sigaddset(&signals, SIGTERM);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
+  // The simulated world, when a device is 'sim'.
+  std::optional<sim::Scenario> scenario;
+  if (companiond::uses_sim(cfg)) {
+    std::string error;
+    scenario = companiond::build_scenario(sim_opts, error);
+    if (!scenario) {
+      spdlog::critical("simulation: {}", error);
+      firmware::shutdown_logging();
+      return 2;
+    }
+    if (duration_s == 0) duration_s = scenario->duration_s;
+    spdlog::info("simulation: '{}' ({}), {:.1f} s, seed {}", scenario->name,
+                 scenario->description, duration_s, sim_opts.seed);
+    if (sim_opts.sim_clock) {
+      if (cfg.devices.tracker != "sim" || cfg.devices.lidar != "sim" || cfg.devices.base != "sim") {
+        spdlog::critical("--sim-clock needs every device to be 'sim'");
+        firmware::shutdown_logging();
+        return 2;
+      }
+      const int rc = companiond::run_on_sim_clock(cfg, sim_opts, *scenario, duration_s);
+      firmware::shutdown_logging();
+      return rc;
+    }
+  }
+
   hal::SystemdNotifier notifier;
   hal::LinuxClock clock;
   firmware::Daemon daemon(cfg, notifier);
+  if (!status_file.empty()) daemon.set_status_file(status_file);
+  std::unique_ptr<sim::WorldThread> world;
+  if (scenario) {
+    world = std::make_unique<sim::WorldThread>(
+        *scenario, sim::world_config(cfg, sim_opts.seed),
+        sim::MetricsConfig{cfg.interactive_space.ellipse_a_m, cfg.interactive_space.ellipse_b_m},
+        clock);
+  }
   // The base's CAN link. Without it the robot cannot move and the supervisor says why
   // (base feedback silent); the daemon still runs so that it can be diagnosed.
   const std::string& base_uri = cfg.devices.base;
@@ -124,7 +190,12 @@ int run(int argc, char** argv) {
       spdlog::info("base: Scout Mini on {}", base_uri);
     }
   } else if (base_uri == "sim") {
-    spdlog::warn("base: 'sim' needs the simulated world (issue 7); no base attached");
+    if (!daemon.attach_base(world->world().take_base_bus())) {
+      spdlog::critical("task table: base and control tasks must share a rate group");
+      firmware::shutdown_logging();
+      return 1;
+    }
+    spdlog::info("base: simulated Scout Mini (CAN frames on an in-process bus)");
   }
   // The tracker's link: opened (and reopened after an unplug, with back-off) by the tracker task
   // itself, so a missing tracker at boot is a HOLD with a reason, not a failed start.
@@ -143,7 +214,9 @@ int run(int argc, char** argv) {
     spdlog::info("tracker: Amfitrack on {} (sensor TX id {})", tracker_uri,
                  cfg.tracker.sensor_tx_id);
   } else if (tracker_uri == "sim") {
-    spdlog::warn("tracker: 'sim' needs the simulated world (issue 7); no tracker attached");
+    daemon.attach_tracker(world->world().take_tracker_link());
+    spdlog::info("tracker: simulated Amfitrack (Amfiprot packets, sensor TX id {})",
+                 cfg.tracker.sensor_tx_id);
   }
   // The VLP-16's data stream. Without it the supervisor holds (lidar silent) and says so.
   const std::string& lidar_uri = cfg.devices.lidar;
@@ -169,7 +242,8 @@ int run(int argc, char** argv) {
       daemon.attach_lidar(std::move(opened.receiver));
     }
   } else if (lidar_uri == "sim") {
-    spdlog::warn("lidar: 'sim' needs the simulated world (issue 7); no lidar attached");
+    daemon.attach_lidar(world->world().take_lidar_source());
+    spdlog::info("lidar: simulated VLP-16 (1206-byte packets ray cast from the world)");
   }
   // The learned selector, when configured: it must load completely, or the daemon does not start.
   if (!cfg.policy.file.empty()) {
@@ -190,7 +264,9 @@ int run(int argc, char** argv) {
   }
   firmware::Executor executor(clock, firmware::group_table(), daemon.bindings());
   daemon.attach(executor);
-  executor.start(clock.now() + std::chrono::milliseconds(10), cfg.realtime.enable);
+  const core::Nanos origin = clock.now() + std::chrono::milliseconds(10);
+  if (world) world->start(origin, daemon);
+  executor.start(origin, cfg.realtime.enable);
 
   if (cfg.realtime.enable) {
     std::string failed;
@@ -226,9 +302,17 @@ int run(int argc, char** argv) {
   const auto started = clock.now();
   bool stopping = false;
   core::Nanos stop_deadline{0};
+  core::Nanos next_live = started + std::chrono::seconds(1);
+  const bool tty = isatty(STDOUT_FILENO) == 1;
   for (;;) {
     const int sig = wait_signal(signals, std::chrono::milliseconds(50));
     const auto now = clock.now();
+    if (live && now >= next_live) {
+      // In place on a terminal, one line per second otherwise (a log file, a pipe).
+      const std::string line = companiond::live_line(daemon, world.get());
+      std::cout << (tty ? "\r\033[K" : "") << line << (tty ? "" : "\n") << std::flush;
+      next_live += std::chrono::seconds(1);
+    }
     const bool timed_out = duration_s > 0 && core::to_seconds(now - started) >= duration_s;
     if ((sig != 0 || timed_out) && !stopping) {
       spdlog::info("{}: stopping the robot, then exiting",
@@ -250,8 +334,20 @@ int run(int argc, char** argv) {
       break;
     }
   }
+  if (live && tty) std::cout << "\n";
   executor.stop();
   spdlog::info("final timing: {}", daemon.timing_summary());
+  if (world) {
+    world->stop();
+    const auto& b = world->world().base().velocity();
+    spdlog::info("simulation: stopped at t={:.1f} s, base velocity {:.3f} {:.3f} {:.3f}",
+                 world->time_s(), b.vx_mps, b.vy_mps, b.wz_radps);
+    if (!sim_opts.report_dir.empty()) {
+      companiond::write_report(sim_opts.report_dir, *scenario, *world,
+                               fmt::format("companiond on '{}' (real time)", scenario->name),
+                               daemon.status_line() + "\n" + daemon.timing_summary());
+    }
+  }
   firmware::shutdown_logging();
   return 0;
 }

@@ -4,6 +4,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <cmath>
 #include <limits>
 
@@ -668,11 +671,24 @@ void Daemon::report_task(const core::Tick& tick) {
   }
   line += " | " + rates;
   if (!shells.empty()) line += " | not yet implemented: " + shells;
-  status_ = line;
-  if (status_ != last_status_sent_) {
-    notifier_.status(status_);
-    last_status_sent_ = status_;
+  std::string compact;
+  for (size_t i = 0; i < n; ++i) {
+    const double hz = measured_rate_hz_[i];
+    compact += fmt::format("{}{} {}", compact.empty() ? "" : " ", executor_->spec(i).name,
+                           std::isnan(hz) ? std::string("-") : fmt::format("{:.0f}", hz));
   }
+  std::string json = build_status_json(tick.now);
+  {
+    const std::scoped_lock lock(report_mutex_);
+    status_ = line;
+    rates_ = std::move(compact);
+    json_ = std::move(json);
+  }
+  if (line != last_status_sent_) {
+    notifier_.status(line);
+    last_status_sent_ = line;
+  }
+  write_status_file();
 
   const Nanos summary_every = std::chrono::duration_cast<Nanos>(
       std::chrono::duration<double>(cfg_.logging.summary_period_s));
@@ -718,7 +734,152 @@ std::string Daemon::lidar_text(Nanos now) const {
 }
 
 std::string Daemon::status_line() const {
+  const std::scoped_lock lock(report_mutex_);
   return status_;
+}
+
+std::string Daemon::rates_text() const {
+  const std::scoped_lock lock(report_mutex_);
+  return rates_;
+}
+
+std::string Daemon::status_json() const {
+  const std::scoped_lock lock(report_mutex_);
+  return json_;
+}
+
+namespace {
+std::string json_string(std::string_view s) {
+  std::string out = "\"";
+  for (const char c : s) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      out += fmt::format("\\u{:04x}", static_cast<int>(c));
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+std::string json_number(double v) {
+  return std::isfinite(v) ? fmt::format("{:.6g}", v) : std::string("null");
+}
+
+double age_ms(Nanos now, Nanos stamp) {
+  return stamp == core::kNever ? std::numeric_limits<double>::quiet_NaN() : core::to_ms(now - stamp);
+}
+}  // namespace
+
+std::string Daemon::build_status_json(Nanos now) const {
+  // Schema: docs in README.md ("Diagnose"); stable keys, units in the names.
+  std::string j = fmt::format("{{\"time_s\": {:.3f}", core::to_seconds(now));
+  if (const auto s = safety_.read()) {
+    std::string active;
+    for (size_t i = 0; i < core::kReasonCount; ++i) {
+      if ((s->value.active_mask >> i & 1U) != 0) {
+        active += fmt::format("{}{}", active.empty() ? "" : ", ",
+                              json_string(core::kReasonTable[i].name));
+      }
+    }
+    j += fmt::format(
+        ", \"safety\": {{\"state\": {}, \"reason\": {}, \"reason_code\": {}, \"reason_text\": "
+        "{}, \"motion_allowed\": {}, \"active_reasons\": [{}]}}",
+        json_string(core::state_name(s->value.state)), json_string(core::reason_name(s->value.reason)),
+        static_cast<int>(s->value.reason), json_string(core::reason_text(s->value.reason)),
+        s->value.motion_allowed, active);
+  }
+  if (const auto g = goal_.read()) {
+    const CompanionGoal& v = g->value;
+    j += fmt::format(
+        ", \"goal\": {{\"status\": {}, \"selector\": {}, \"side\": {}, \"index\": {}, "
+        "\"x_base_m\": {}, \"y_base_m\": {}, \"free_points\": {}, \"points\": {}, \"age_ms\": {}}}",
+        json_string(core::to_string(v.status)), json_string(v.selector),
+        json_string(side_of_person(v.index, v.points)), v.index, json_number(v.goal_base.x_m),
+        json_number(v.goal_base.y_m), v.free_points, v.points, json_number(age_ms(now, g->stamp)));
+  }
+  if (const auto t = tracker_health_.read()) {
+    const TrackerHealth& h = t->value;
+    j += fmt::format(
+        ", \"tracker\": {{\"link_up\": {}, \"confidence\": {}, \"gate_reason\": {}, \"quality\": "
+        "{}, \"rate_hz\": {}, \"frame_age_ms\": {}, \"person_distance_m\": {}, \"frames\": {}, "
+        "\"dropped_frames\": {}, \"decode_errors\": {}, \"filter_rejected\": {}, "
+        "\"filter_resets\": {}}}",
+        h.link_up, json_string(core::confidence_name(h.confidence)),
+        json_string(amfitrack::to_string(h.gate_reason)), h.quality, json_number(h.rate_hz),
+        json_number(age_ms(now, h.frame_stamp)), json_number(h.person_distance_m), h.frames,
+        h.dropped_frames, h.decode_errors, h.filter_rejected, h.filter_resets);
+  }
+  if (const auto l = lidar_health_.read()) {
+    const LidarHealth& h = l->value;
+    j += fmt::format(
+        ", \"lidar\": {{\"packets\": {}, \"packet_age_ms\": {}, \"costmap_age_ms\": {}, "
+        "\"scans\": {}, \"decode_errors\": {}, \"lost_packets\": {}, \"kernel_drops\": {}, "
+        "\"obstacle_cells\": {}}}",
+        h.packets, json_number(age_ms(now, h.packet_stamp)), json_number(age_ms(now, h.costmap_stamp)),
+        h.scans, h.decode_errors, h.lost_packets, h.kernel_drops, h.obstacle_cells);
+  }
+  if (const auto b = base_health_.read()) {
+    const BaseHealth& h = b->value;
+    j += fmt::format(
+        ", \"base\": {{\"feedback_age_ms\": {}, \"can_mode\": {}, \"estop\": {}, "
+        "\"rc_override\": {}, \"bus_off\": {}, \"fault_word\": {}, \"write_errors\": {}, "
+        "\"vx_mps\": {}, \"vy_mps\": {}, \"wz_radps\": {}}}",
+        json_number(age_ms(now, h.feedback_stamp)), h.can_mode, h.estop, h.rc_override, h.bus_off,
+        h.fault_word, h.write_errors, json_number(h.vx_mps), json_number(h.vy_mps),
+        json_number(h.wz_radps));
+  }
+  if (const auto c = control_status_.read()) {
+    const ControlStatus& v = c->value;
+    j += fmt::format(
+        ", \"control\": {{\"tracking\": {}, \"runs\": {}, \"failures\": {}, \"repairs\": {}, "
+        "\"effective_samples\": {}, \"vx_mps\": {}, \"vy_mps\": {}, \"wz_radps\": {}}}",
+        v.tracking, v.runs, v.failures, v.repairs, json_number(v.effective_samples),
+        json_number(v.command.vx_mps), json_number(v.command.vy_mps),
+        json_number(v.command.wz_radps));
+  }
+  if (executor_ != nullptr) {
+    std::string tasks;
+    for (size_t i = 0; i < executor_->task_count(); ++i) {
+      const auto& st = executor_->stats(i);
+      const double rate = i < measured_rate_hz_.size() ? measured_rate_hz_[i]
+                                                       : std::numeric_limits<double>::quiet_NaN();
+      tasks += fmt::format(
+          "{}{{\"name\": {}, \"rate_hz\": {}, \"nominal_hz\": {}, \"budget_us\": {}, "
+          "\"jitter_p50_us\": {}, \"jitter_p99_us\": {}, \"jitter_max_us\": {}, \"run_p50_us\": {}, "
+          "\"run_p99_us\": {}, \"run_max_us\": {}, \"runs\": {}, \"overruns\": {}, \"skipped\": {}, "
+          "\"over_budget\": {}}}",
+          tasks.empty() ? "" : ", ", json_string(executor_->spec(i).name), json_number(rate),
+          executor_->spec(i).rate_hz, executor_->spec(i).budget_us,
+          json_number(core::to_us(st.period_jitter().quantile(0.5))),
+          json_number(core::to_us(st.period_jitter().quantile(0.99))),
+          json_number(core::to_us(st.period_jitter().max())),
+          json_number(core::to_us(st.run_time().quantile(0.5))),
+          json_number(core::to_us(st.run_time().quantile(0.99))),
+          json_number(core::to_us(st.run_time().max())), st.runs(), st.overruns(), st.skipped(),
+          st.budget_exceeded());
+    }
+    j += ", \"tasks\": [" + tasks + "]";
+  }
+  return j + "}\n";
+}
+
+void Daemon::write_status_file() {
+  if (status_file_.empty()) return;
+  // Atomic replace: a reader never sees half a file.
+  const std::string tmp = status_file_ + ".tmp";
+  std::string json = status_json();
+  std::FILE* f = std::fopen(tmp.c_str(), "w");
+  bool ok = f != nullptr && std::fwrite(json.data(), 1, json.size(), f) == json.size();
+  if (f != nullptr) ok = std::fclose(f) == 0 && ok;
+  if (ok) ok = std::rename(tmp.c_str(), status_file_.c_str()) == 0;
+  if (!ok && !status_file_warned_) {
+    spdlog::warn("status: cannot write {}: {} (not retried in the log)", status_file_,
+                 std::strerror(errno));
+    status_file_warned_ = true;
+  }
 }
 
 std::string Daemon::timing_summary() const {

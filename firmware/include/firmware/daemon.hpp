@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -178,8 +179,15 @@ class Daemon {
   [[nodiscard]] const core::LatestValue<core::BodyVelocity>& command() const { return command_; }
 
   // One line: "HOLD: tracker silent (+2: ...) | tracker 120.0Hz ... | shells: ...".
-  // Built by the report task; rates are measured over its last period.
+  // Built by the report task; rates are measured over its last period. Any thread.
   [[nodiscard]] std::string status_line() const;
+  // "tracker 120 base 50 ..." (Hz, measured by the report task). Any thread.
+  [[nodiscard]] std::string rates_text() const;
+  // The machine-readable status (JSON object), built by the report task. Any thread.
+  [[nodiscard]] std::string status_json() const;
+  // Where the report task writes status_json() (atomically, each run); empty: nowhere.
+  // Before start.
+  void set_status_file(std::string path) { status_file_ = std::move(path); }
   // Per-task timing summary (rate, jitter p50/p99/max, run time p99/max, overruns, skips).
   [[nodiscard]] std::string timing_summary() const;
 
@@ -262,6 +270,13 @@ class Daemon {
   std::vector<double> measured_rate_hz_;
   std::string status_;
   std::string last_status_sent_;
+  std::string rates_;
+  std::string json_;
+  std::string status_file_;
+  bool status_file_warned_ = false;
+  mutable std::mutex report_mutex_;  // status_, rates_, json_ (read by other threads)
+  std::string build_status_json(core::Nanos now) const;
+  void write_status_file();
 };
 
 }  // namespace firmware

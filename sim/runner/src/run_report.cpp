@@ -1,0 +1,283 @@
+#include "sim/run_report.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+
+namespace sim {
+
+double quantile(std::vector<double> v, double p) {
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const auto k = static_cast<size_t>(std::clamp(p, 0.0, 1.0) * static_cast<double>(v.size() - 1));
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+
+namespace {
+
+struct Bounds {
+  double x0 = 1e9, y0 = 1e9, x1 = -1e9, y1 = -1e9;
+  void add(double x, double y) {
+    x0 = std::min(x0, x);
+    y0 = std::min(y0, y);
+    x1 = std::max(x1, x);
+    y1 = std::max(y1, y);
+  }
+};
+
+std::string json_escape(const std::string& s) {
+  std::string out;
+  for (const char c : s) {
+    switch (c) {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          out += fmt::format("\\u{:04x}", static_cast<int>(c));
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out;
+}
+
+std::string xml_escape(const std::string& s) {
+  std::string out;
+  for (const char c : s) {
+    if (c == '<') {
+      out += "&lt;";
+    } else if (c == '>') {
+      out += "&gt;";
+    } else if (c == '&') {
+      out += "&amp;";
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string trajectory_svg(const RunReportInputs& in) {
+  const Scenario& sc = *in.scenario;
+  const auto& samples = *in.samples;
+  Bounds b;
+  for (const RunSample& s : samples) {
+    b.add(s.robot.x_m, s.robot.y_m);
+    b.add(s.person.x_m, s.person.y_m);
+  }
+  if (samples.empty()) b.add(0, 0);
+  for (const Segment& s : sc.world.segments) {
+    // Walls far from the action are clipped by the view box, not allowed to stretch it.
+    auto near = [&](const Point2& p) {
+      return p.x_m > b.x0 - 4 && p.x_m < b.x1 + 4 && p.y_m > b.y0 - 4 && p.y_m < b.y1 + 4;
+    };
+    if (near(s.a)) b.add(s.a.x_m, s.a.y_m);
+    if (near(s.b)) b.add(s.b.x_m, s.b.y_m);
+  }
+  const double margin = 1.5;
+  b.x0 -= margin;
+  b.y0 -= margin;
+  b.x1 += margin;
+  b.y1 += margin;
+  const double scale = 900.0 / std::max(b.x1 - b.x0, b.y1 - b.y0);  // px per m
+  const double w = (b.x1 - b.x0) * scale;
+  const double h = (b.y1 - b.y0) * scale;
+  auto X = [&](double x) { return (x - b.x0) * scale; };
+  auto Y = [&](double y) { return (b.y1 - y) * scale; };  // y up
+  std::string svg = fmt::format(
+      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{:.0f}\" height=\"{:.0f}\" "
+      "viewBox=\"0 0 {:.0f} {:.0f}\" font-family=\"sans-serif\" font-size=\"13\">\n"
+      "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n",
+      w, h + 70, w, h + 70);
+  // 1 m grid.
+  for (double x = std::ceil(b.x0); x <= b.x1; x += 1.0) {
+    svg += fmt::format("<line x1=\"{0:.1f}\" y1=\"0\" x2=\"{0:.1f}\" y2=\"{1:.1f}\" stroke=\"#eee\"/>\n",
+                       X(x), h);
+  }
+  for (double y = std::ceil(b.y0); y <= b.y1; y += 1.0) {
+    svg += fmt::format("<line x1=\"0\" y1=\"{0:.1f}\" x2=\"{1:.1f}\" y2=\"{0:.1f}\" stroke=\"#eee\"/>\n",
+                       Y(y), w);
+  }
+  for (const Segment& s : sc.world.segments) {
+    svg += fmt::format(
+        "<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#333\" "
+        "stroke-width=\"4\"/>\n",
+        X(s.a.x_m), Y(s.a.y_m), X(s.b.x_m), Y(s.b.y_m));
+  }
+  for (const Circle& c : sc.world.circles) {
+    svg += fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"{:.1f}\" fill=\"#555\"/>\n",
+                       X(c.center.x_m), Y(c.center.y_m), c.radius_m * scale);
+  }
+  // Pedestrians: faint dots every sample.
+  std::string peds;
+  for (size_t i = 0; i < samples.size(); i += 2) {
+    for (const Point2& p : samples[i].pedestrians) {
+      peds += fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"1.6\"/>", X(p.x_m), Y(p.y_m));
+    }
+  }
+  svg += "<g fill=\"#e39b2b\" fill-opacity=\"0.35\">" + peds + "</g>\n";
+  // Chosen points q^d (while active): small crosses.
+  std::string goals;
+  for (size_t i = 0; i < samples.size(); i += 3) {
+    const RunSample& s = samples[i];
+    if (!s.has_goal || !s.active) continue;
+    goals += fmt::format("M{:.1f} {:.1f}h6M{:.1f} {:.1f}v6 ", X(s.goal.x_m) - 3, Y(s.goal.y_m),
+                         X(s.goal.x_m), Y(s.goal.y_m) - 3);
+  }
+  svg += "<path d=\"" + goals + "\" stroke=\"#2a9d3a\" stroke-width=\"1.2\" fill=\"none\"/>\n";
+  auto polyline = [&](auto pick, const char* colour, double width) {
+    std::string pts;
+    for (const RunSample& s : samples) {
+      const core::Pose2 p = pick(s);
+      pts += fmt::format("{:.1f},{:.1f} ", X(p.x_m), Y(p.y_m));
+    }
+    return fmt::format(
+        "<polyline points=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"{}\" "
+        "stroke-linejoin=\"round\"/>\n",
+        pts, colour, width);
+  };
+  svg += polyline([](const RunSample& s) { return s.person; }, "#1f5fbf", 2.5);
+  svg += polyline([](const RunSample& s) { return s.robot; }, "#c0392b", 2.5);
+  // Every 2 s: the robot's footprint heading tick and a thin link robot-person.
+  for (size_t i = 0; i < samples.size(); i += 20) {
+    const RunSample& s = samples[i];
+    svg += fmt::format(
+        "<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#999\" "
+        "stroke-dasharray=\"3 3\"/>\n",
+        X(s.robot.x_m), Y(s.robot.y_m), X(s.person.x_m), Y(s.person.y_m));
+    svg += fmt::format(
+        "<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#c0392b\" "
+        "stroke-width=\"2\"/>\n",
+        X(s.robot.x_m), Y(s.robot.y_m), X(s.robot.x_m + 0.4 * std::cos(s.robot.theta_rad)),
+        Y(s.robot.y_m + 0.4 * std::sin(s.robot.theta_rad)));
+    svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" fill=\"#777\" font-size=\"10\">{:.0f}s</text>\n",
+                       X(s.person.x_m) + 4, Y(s.person.y_m) - 4, s.t_s);
+  }
+  // Legend and title.
+  const double ly = h + 20;
+  svg += fmt::format(
+      "<text x=\"10\" y=\"{:.0f}\" font-weight=\"bold\">{}</text>\n"
+      "<text x=\"10\" y=\"{:.0f}\"><tspan fill=\"#1f5fbf\">person</tspan>  "
+      "<tspan fill=\"#c0392b\">robot</tspan>  <tspan fill=\"#2a9d3a\">chosen points q^d</tspan>  "
+      "<tspan fill=\"#e39b2b\">pedestrians</tspan>  <tspan fill=\"#333\">walls/obstacles</tspan>  "
+      "grid 1 m, labels: time along the person's walk</text>\n",
+      ly, xml_escape(in.title), ly + 22);
+  svg += "</svg>\n";
+  return svg;
+}
+
+std::string report_markdown(const RunReportInputs& in) {
+  const RunMetrics& m = *in.metrics;
+  std::string md = fmt::format("# {}\n\n{}\n\n", in.title, in.scenario->description);
+  md += fmt::format("**Result: {}**{}\n\n", m.success ? "SUCCESS" : "FAILURE",
+                    m.success ? "" : " - " + m.failure);
+  md += "| metric | value |\n|---|---|\n";
+  md += fmt::format("| duration | {:.1f} s (moving allowed {:.1f} s, stops {}) |\n", m.duration_s,
+                    m.active_s, m.stops);
+  md += fmt::format("| collision | {} |\n", m.collision ? "yes" : "no");
+  md += fmt::format("| UT (robot < 0.45 m from the person) | {:.2f} s |\n", m.uncomfortable_s);
+  md += fmt::format("| time inside the CBF ellipse (h < 0) | {:.2f} s |\n", m.inside_ellipse_s);
+  md += fmt::format("| RMSE e_x / e_y / e_theta | {:.3f} m / {:.3f} m / {:.3f} rad |\n", m.rmse_ex_m,
+                    m.rmse_ey_m, m.rmse_etheta_rad);
+  md += fmt::format("| person distance min / mean / max (moving) | {:.2f} / {:.2f} / {:.2f} m |\n",
+                    m.min_person_distance_m, m.mean_person_distance_m, m.max_person_distance_m);
+  md += fmt::format("| longest stretch > 2 m from the person | {:.1f} s |\n", m.longest_far_s);
+  auto clearance = [](double v) { return v > 1e6 ? std::string("-") : fmt::format("{:.2f} m", v); };
+  md += fmt::format("| min clearance obstacles / people (footprint) | {} / {} |\n",
+                    clearance(m.min_static_clearance_m), clearance(m.min_people_clearance_m));
+  md += fmt::format("| RMS jerk of the command | {:.1f} m/s^3 |\n", m.rms_jerk);
+  if (!in.policy_ms.empty()) {
+    md += fmt::format("| policy step p50 / p99 | {:.3f} / {:.3f} ms |\n", quantile(in.policy_ms, 0.5),
+                      quantile(in.policy_ms, 0.99));
+  }
+  if (!in.control_ms.empty()) {
+    md += fmt::format("| control step (MPPI-CBF + repair) p50 / p99 | {:.3f} / {:.3f} ms |\n",
+                      quantile(in.control_ms, 0.5), quantile(in.control_ms, 0.99));
+  }
+  md += "\nWhere the robot was around the person while moving (share of the time):\n\n";
+  double total = 0;
+  for (double t : m.side_time_s)
+    total += t;
+  md += "| front | front-left | left | behind-left | behind | behind-right | right | front-right |\n";
+  md += "|---|---|---|---|---|---|---|---|\n|";
+  for (double t : m.side_time_s)
+    md += fmt::format(" {:.0f} % |", total > 0 ? 100.0 * t / total : 0.0);
+  md += "\n\n![trajectories](trajectory.svg)\n";
+  if (!in.notes.empty()) md += "\n```\n" + in.notes + "\n```\n";
+  return md;
+}
+
+std::string metrics_json(const RunReportInputs& in) {
+  const RunMetrics& m = *in.metrics;
+  std::string sides;
+  for (double t : m.side_time_s)
+    sides += fmt::format("{}{:.3f}", sides.empty() ? "" : ", ", t);
+  return fmt::format(
+      "{{\n  \"scenario\": \"{}\",\n  \"success\": {},\n  \"failure\": \"{}\",\n"
+      "  \"collision\": {},\n  \"duration_s\": {:.3f},\n  \"active_s\": {:.3f},\n"
+      "  \"uncomfortable_s\": {:.3f},\n  \"inside_ellipse_s\": {:.3f},\n"
+      "  \"rmse_ex_m\": {:.4f},\n  \"rmse_ey_m\": {:.4f},\n  \"rmse_etheta_rad\": {:.4f},\n"
+      "  \"min_person_distance_m\": {:.3f},\n  \"mean_person_distance_m\": {:.3f},\n"
+      "  \"max_person_distance_m\": {:.3f},\n  \"longest_far_s\": {:.3f},\n"
+      "  \"min_static_clearance_m\": {:.3f},\n  \"min_people_clearance_m\": {:.3f},\n"
+      "  \"rms_jerk\": {:.3f},\n  \"stops\": {},\n  \"side_time_s\": [{}],\n"
+      "  \"policy_ms_p50\": {:.4f},\n  \"policy_ms_p99\": {:.4f},\n"
+      "  \"control_ms_p50\": {:.4f},\n  \"control_ms_p99\": {:.4f}\n}}\n",
+      json_escape(in.scenario->name), m.success, json_escape(m.failure), m.collision, m.duration_s,
+      m.active_s, m.uncomfortable_s, m.inside_ellipse_s, m.rmse_ex_m, m.rmse_ey_m,
+      m.rmse_etheta_rad, m.min_person_distance_m, m.mean_person_distance_m,
+      m.max_person_distance_m, m.longest_far_s, std::min(m.min_static_clearance_m, 1e6),
+      std::min(m.min_people_clearance_m, 1e6), m.rms_jerk, m.stops, sides,
+      in.policy_ms.empty() ? 0.0 : quantile(in.policy_ms, 0.5),
+      in.policy_ms.empty() ? 0.0 : quantile(in.policy_ms, 0.99),
+      in.control_ms.empty() ? 0.0 : quantile(in.control_ms, 0.5),
+      in.control_ms.empty() ? 0.0 : quantile(in.control_ms, 0.99));
+}
+
+std::string samples_csv(const std::vector<RunSample>& samples) {
+  std::string out =
+      "t_s,robot_x_m,robot_y_m,robot_theta_rad,person_x_m,person_y_m,person_theta_rad,active,"
+      "has_goal,goal_x_m,goal_y_m,side,pedestrians\n";
+  for (const RunSample& s : samples) {
+    out += fmt::format("{:.3f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{},{},{:.4f},{:.4f},{},{}\n",
+                       s.t_s, s.robot.x_m, s.robot.y_m, s.robot.theta_rad, s.person.x_m,
+                       s.person.y_m, s.person.theta_rad, s.active ? 1 : 0, s.has_goal ? 1 : 0,
+                       s.goal.x_m, s.goal.y_m, s.side, s.pedestrians.size());
+  }
+  return out;
+}
+
+std::string write_run_report(const std::string& dir, const RunReportInputs& in) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return fmt::format("cannot create {}: {}", dir, ec.message());
+  const std::pair<const char*, std::string> files[] = {
+      {"report.md", report_markdown(in)},
+      {"metrics.json", metrics_json(in)},
+      {"samples.csv", samples_csv(*in.samples)},
+      {"trajectory.svg", trajectory_svg(in)},
+  };
+  for (const auto& [name, text] : files) {
+    const std::string path = dir + "/" + name;
+    std::ofstream f(path);
+    f << text;
+    if (!f) return fmt::format("cannot write {}", path);
+  }
+  return {};
+}
+
+}  // namespace sim
