@@ -6,7 +6,8 @@
 JOBS ?= $(shell nproc)
 TSAN_TARGETS := test_core_channel test_hal_clock test_firmware_executor test_firmware_daemon \
   test_drivers_amfitrack_threads
-FUZZERS := fuzz_candump_line fuzz_slcan_stream fuzz_scout_decode fuzz_amfiprot fuzz_vlp16
+FUZZERS := fuzz_candump_line fuzz_slcan_stream fuzz_scout_decode fuzz_amfiprot fuzz_vlp16 \
+  fuzz_pedestrian_dataset
 FUZZ_SECONDS ?= 10
 
 deps:

@@ -74,7 +74,7 @@ int run(int argc, char** argv) {
                    "seconds between consecutive frame values in --pedestrians")
       ->check(CLI::PositiveNumber);
   simg->add_option("--follow", sim_opts.follow_id,
-                   "id of the recorded person to accompany (default: observed longest)");
+                   "id of the recorded person to accompany (default: who walks farthest)");
   simg->add_flag("--sim-clock", sim_opts.sim_clock,
                  "run on the simulated clock (deterministic, faster than real time)");
   simg->add_option("--report", sim_opts.report_dir,

@@ -25,15 +25,7 @@ std::optional<sim::Scenario> build_scenario(const SimOptions& o, std::string& er
       return std::nullopt;
     }
     int id = o.follow_id;
-    if (id < 0) {  // the person observed the longest
-      double best = -1;
-      for (const auto& [pid, tr] : loaded.data.people) {
-        if (tr.end_s() - tr.start_s() > best) {
-          best = tr.end_s() - tr.start_s();
-          id = pid;
-        }
-      }
-    }
+    if (id < 0) id = sim::longest_walk(loaded.data);
     auto s = sim::recorded_scenario(loaded.data, id, &error);
     if (s) s->name = fmt::format("{} (person {})", o.pedestrians_file, id);
     return s;

@@ -22,7 +22,7 @@ struct SimOptions {
   uint32_t seed = 1;
   std::string pedestrians_file;  // recorded pedestrians (frame id x y)
   double frame_period_s = 0.4;
-  int follow_id = -1;  // -1: the recorded person observed longest
+  int follow_id = -1;  // -1: the recorded person who walks the farthest
   bool sim_clock = false;
   std::string report_dir;
 };

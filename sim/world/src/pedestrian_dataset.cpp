@@ -18,6 +18,9 @@ struct Row {
   int id;
 };
 
+// A day of recording: frame values spanning more than this are not frame numbers.
+constexpr double kMaxDurationS = 86400.0;
+
 bool parse_double(const std::string& token, double& out) {
   errno = 0;
   char* end = nullptr;
@@ -82,6 +85,11 @@ DatasetLoad parse_pedestrian_dataset(const std::string& text, double frame_perio
   std::map<int, std::vector<TimedPose>> by_id;
   for (const Row& row : rows) {
     const double t = (row.frame - first) / step * frame_period_s;
+    if (!std::isfinite(t) || t > kMaxDurationS) {
+      r.error = fmt::format("{}: frame {} is {} s after the first: not a recording", name,
+                            row.frame, t);
+      return r;
+    }
     by_id[row.id].push_back({t, {row.x, row.y, 0.0}});
   }
   for (auto& [id, samples] : by_id) {
@@ -98,6 +106,19 @@ DatasetLoad parse_pedestrian_dataset(const std::string& text, double frame_perio
   r.data.rows = rows.size();
   r.ok = true;
   return r;
+}
+
+int longest_walk(const PedestrianDataset& dataset) {
+  int best_id = -1;
+  double best = -1;
+  for (const auto& [id, tr] : dataset.people) {
+    const double len = path_length(tr);
+    if (len > best) {
+      best = len;
+      best_id = id;
+    }
+  }
+  return best_id;
 }
 
 DatasetLoad load_pedestrian_dataset(const std::string& path, double frame_period_s) {

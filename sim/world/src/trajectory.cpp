@@ -32,12 +32,16 @@ core::Point2 Trajectory::velocity_at(double t_s) const {
 }
 
 void set_headings_from_motion(std::vector<TimedPose>& samples) {
+  // Below this speed a person is standing: recorded positions then jitter by centimetres and
+  // their direction means nothing, so the heading is kept.
+  constexpr double kWalkingMps = 0.2;
   double heading = 0;
   bool known = false;
   for (size_t i = 0; i + 1 < samples.size(); ++i) {
     const double dx = samples[i + 1].pose.x_m - samples[i].pose.x_m;
     const double dy = samples[i + 1].pose.y_m - samples[i].pose.y_m;
-    if (std::hypot(dx, dy) > 1e-3) {
+    const double dt = samples[i + 1].t_s - samples[i].t_s;
+    if (dt > 0 && std::hypot(dx, dy) >= kWalkingMps * dt) {
       heading = std::atan2(dy, dx);
       if (!known) {
         for (size_t j = 0; j < i; ++j)
@@ -48,6 +52,14 @@ void set_headings_from_motion(std::vector<TimedPose>& samples) {
     samples[i].pose.theta_rad = heading;
   }
   if (!samples.empty()) samples.back().pose.theta_rad = heading;
+}
+
+double path_length(const Trajectory& t) {
+  double len = 0;
+  const auto& s = t.samples();
+  for (size_t i = 1; i < s.size(); ++i)
+    len += std::hypot(s[i].pose.x_m - s[i - 1].pose.x_m, s[i].pose.y_m - s[i - 1].pose.y_m);
+  return len;
 }
 
 Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s, double step_s) {

@@ -28,4 +28,7 @@ DatasetLoad parse_pedestrian_dataset(const std::string& text, double frame_perio
                                      const std::string& name = "<text>");
 DatasetLoad load_pedestrian_dataset(const std::string& path, double frame_period_s);
 
+// The id of the person who walks the farthest (a good default to follow); -1 when empty.
+int longest_walk(const PedestrianDataset& dataset);
+
 }  // namespace sim

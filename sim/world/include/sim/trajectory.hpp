@@ -41,7 +41,9 @@ struct Waypoint {
 Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s = 0.0,
                 double step_s = 0.05);
 
-// Headings of position samples from their motion (kept while standing).
+// Headings of position samples from their motion (kept while standing: below 0.2 m/s).
+// Path length walked (m).
+double path_length(const Trajectory& t);
 void set_headings_from_motion(std::vector<TimedPose>& samples);
 
 }  // namespace sim

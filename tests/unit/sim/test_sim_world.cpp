@@ -1,0 +1,401 @@
+// The simulated world's parts: geometry, walks, recorded datasets, social force, the VLP-16
+// emulation (decoded by the real decoder), the tracker emulation (read by the real person frame),
+// the in-process datagram link, and the run metrics.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <numbers>
+
+#include "amfitrack/amfiprot_codec.hpp"
+#include "amfitrack/person_frame.hpp"
+#include "hal/net/datagram_queue.hpp"
+#include "hal/sim_clock.hpp"
+#include "sim/pedestrian_dataset.hpp"
+#include "sim/run_metrics.hpp"
+#include "sim/sim_vlp16.hpp"
+#include "sim/sim_world.hpp"
+#include "sim/social_force.hpp"
+#include "vlp16/vlp16_codec.hpp"
+
+using namespace std::chrono_literals;
+using core::Point2;
+using core::Pose2;
+
+// ---- static world ------------------------------------------------------------------------------
+
+TEST(StaticWorld, RaysHitTheFirstWallOrCircle) {
+  sim::StaticWorld w;
+  w.add_wall({5, -10}, {5, 10});
+  w.add_circle({3, 0}, 0.5);
+  auto d = w.ray({0, 0}, 1, 0, 100);
+  ASSERT_TRUE(d);
+  EXPECT_NEAR(*d, 2.5, 1e-9) << "the circle is in front of the wall";
+  d = w.ray({0, 2}, 1, 0, 100);
+  ASSERT_TRUE(d);
+  EXPECT_NEAR(*d, 5.0, 1e-9);
+  EXPECT_FALSE(w.ray({0, 0}, -1, 0, 100)) << "nothing behind";
+  EXPECT_FALSE(w.ray({0, 2}, 1, 0, 4.0)) << "beyond max range";
+  EXPECT_NEAR(w.distance({4, 3}), 1.0, 1e-9);
+  EXPECT_NEAR(w.distance({3, 1}), 0.5, 1e-9);
+}
+
+TEST(StaticWorld, BoxesAreClosedPolygons) {
+  sim::StaticWorld w;
+  w.add_box({1, 1}, {2, 3});
+  EXPECT_EQ(w.segments.size(), 4U);
+  EXPECT_NEAR(*w.ray({0, 2}, 1, 0, 10), 1.0, 1e-9);
+  EXPECT_NEAR(*w.ray({1.5, 0}, 0, 1, 10), 1.0, 1e-9);
+  EXPECT_NEAR(*w.ray({1.5, 5}, 0, -1, 10), 2.0, 1e-9);
+}
+
+// ---- walks -----------------------------------------------------------------------------------
+
+TEST(Walk, LegsAtTheirSpeedsWithSuddenTurns) {
+  const auto t = sim::walk({{{0, 0}}, {{4, 0}, 1.0}, {{4, 2}, 0.5}}, 1.0);
+  EXPECT_NEAR(t.end_s(), 1.0 + 4.0 + 4.0, 1e-9);
+  auto p = t.pose_at(0.5);
+  EXPECT_NEAR(p.x_m, 0.0, 1e-9) << "standing before the start";
+  EXPECT_NEAR(p.theta_rad, 0.0, 1e-9) << "already facing the first leg";
+  p = t.pose_at(3.0);
+  EXPECT_NEAR(p.x_m, 2.0, 1e-6);
+  EXPECT_NEAR(t.velocity_at(3.0).x_m, 1.0, 1e-6);
+  p = t.pose_at(7.0);
+  EXPECT_NEAR(p.x_m, 4.0, 1e-6);
+  EXPECT_NEAR(p.y_m, 1.0, 1e-6);
+  EXPECT_NEAR(p.theta_rad, std::numbers::pi / 2, 1e-6) << "turned at the corner";
+  EXPECT_NEAR(t.velocity_at(7.0).y_m, 0.5, 1e-6);
+  EXPECT_NEAR(t.pose_at(100).y_m, 2.0, 1e-9) << "stays at the end";
+}
+
+TEST(Walk, HeadingIsKeptWhileStanding) {
+  // Recorded positions jitter by a centimetre while a person stands: no spinning heading.
+  std::vector<sim::TimedPose> s;
+  for (int i = 0; i < 10; ++i)
+    s.push_back({0.4 * i, {0.4 * i, 0.0, 0.0}});  // walking +x at 1 m/s
+  for (int i = 10; i < 20; ++i)
+    s.push_back({0.4 * i, {3.6 + (i % 2 == 0 ? 0.01 : -0.01), (i % 3) * 0.01, 0.0}});
+  sim::set_headings_from_motion(s);
+  for (const auto& p : s)
+    EXPECT_NEAR(p.pose.theta_rad, 0.0, 1e-9) << "t=" << p.t_s;
+}
+
+// ---- recorded pedestrian datasets ---------------------------------------------------------------
+
+TEST(PedestrianDataset, ParsesFramesIntoSecondsByTheGivenPeriod) {
+  const std::string text =
+      "0\t1.0\t1.0\t2.0\n"
+      "0\t2.0\t5.0\t5.0\n"
+      "10\t1.0\t1.4\t2.0\n"
+      "20\t1.0\t1.8\t2.0\r\n"
+      "# comment\n"
+      "\n"
+      "20\t2.0\t5.0\t5.4\n";
+  const auto r = sim::parse_pedestrian_dataset(text, 0.4);
+  ASSERT_TRUE(r.ok) << r.error;
+  EXPECT_EQ(r.data.rows, 5U);
+  EXPECT_EQ(r.data.frame_step, 10.0);
+  ASSERT_EQ(r.data.people.size(), 2U);
+  const auto& p1 = r.data.people.at(1);
+  EXPECT_NEAR(p1.end_s(), 0.8, 1e-12);
+  EXPECT_NEAR(p1.pose_at(0.2).x_m, 1.2, 1e-9) << "interpolated between rows";
+  EXPECT_NEAR(p1.velocity_at(0.2).x_m, 1.0, 1e-9);
+  const auto& p2 = r.data.people.at(2);
+  EXPECT_NEAR(p2.end_s(), 0.8, 1e-12) << "a gap of one frame is bridged";
+  EXPECT_NEAR(p2.pose_at(0.4).y_m, 5.2, 1e-9);
+  EXPECT_EQ(sim::longest_walk(r.data), 1);
+}
+
+TEST(PedestrianDataset, BadInputIsAClearErrorWithTheLine) {
+  auto r = sim::parse_pedestrian_dataset("0 1 2 3\n10 1 2\n", 0.4, "f.txt");
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.error, "f.txt:2: expected 4 columns 'frame id x y', got 3");
+  r = sim::parse_pedestrian_dataset("0 1 2 abc\n", 0.4, "f.txt");
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.error, "f.txt:1: column 4 is not a number: 'abc'");
+  r = sim::parse_pedestrian_dataset("0 1 2 nan\n", 0.4, "f.txt");
+  EXPECT_FALSE(r.ok) << "not finite";
+  r = sim::parse_pedestrian_dataset("0 1.5 2 3\n", 0.4, "f.txt");
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.error.find("whole number"), std::string::npos);
+  r = sim::parse_pedestrian_dataset("", 0.4, "f.txt");
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.error, "f.txt: no observations");
+  r = sim::parse_pedestrian_dataset("0 1 2 3\n", 0.0, "f.txt");
+  EXPECT_FALSE(r.ok);
+  r = sim::parse_pedestrian_dataset("0 1 2 3\n1 1 2 3\n1e300 1 2 3\n", 0.4, "f.txt");
+  EXPECT_FALSE(r.ok) << "frame values that span centuries";
+  EXPECT_NE(r.error.find("not a recording"), std::string::npos) << r.error;
+  r = sim::load_pedestrian_dataset("/nonexistent/file.txt", 0.4);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.error.find("cannot open"), std::string::npos);
+}
+
+TEST(PedestrianDataset, LoadsTheShippedRecordings) {
+  for (const char* f : {"biwi_hotel.txt", "crowds_zara01.txt"}) {
+    const auto r =
+        sim::load_pedestrian_dataset(std::string(COMPANION_PEDESTRIANS) + "/" + f, 0.4);
+    ASSERT_TRUE(r.ok) << r.error;
+    EXPECT_GT(r.data.people.size(), 100U) << f;
+    EXPECT_EQ(r.data.frame_step, 10.0) << f;
+    std::string error;
+    const auto s = sim::recorded_scenario(r.data, sim::longest_walk(r.data), &error);
+    ASSERT_TRUE(s) << error;
+    EXPECT_GT(s->replayed.size(), 3U) << f;
+    EXPECT_GT(s->duration_s, 10.0);
+  }
+}
+
+// ---- social force ------------------------------------------------------------------------------
+
+TEST(SocialForce, TwoWalkersHeadOnPassEachOtherAndArrive) {
+  sim::Crowd crowd;
+  sim::Pedestrian a;
+  a.position = {0, 0};
+  a.goals = {{10, 0}};
+  sim::Pedestrian b = a;
+  b.position = {10, 0.1};
+  b.goals = {{0, 0.1}};
+  crowd.add(a);
+  crowd.add(b);
+  sim::StaticWorld none;
+  double closest = 1e9;
+  for (int i = 0; i < 2000; ++i) {
+    crowd.step(0.01, none, {});
+    const auto& p = crowd.people();
+    closest = std::min(closest, std::hypot(p[0].position.x_m - p[1].position.x_m,
+                                           p[0].position.y_m - p[1].position.y_m));
+  }
+  EXPECT_GT(closest, 0.5) << "they step aside (radii 0.25 each)";
+  EXPECT_TRUE(crowd.people()[0].arrived());
+  EXPECT_TRUE(crowd.people()[1].arrived());
+}
+
+TEST(SocialForce, WallsRepelAndForcesFromBehindCountHalf) {
+  sim::Crowd crowd;
+  sim::StaticWorld w;
+  w.add_wall({-10, 0.5}, {10, 0.5});
+  const Point2 f = crowd.wall_force({0, 0}, {1, 0}, w);
+  EXPECT_NEAR(f.x_m, 0.0, 1e-9);
+  EXPECT_NEAR(f.y_m, -10.0 / 0.2 * std::exp(-0.5 / 0.2), 1e-9) << "U0/R exp(-d/R), away";
+  // A standing person 1 m ahead vs 1 m behind: the same magnitude, behind weighted 0.5.
+  const sim::MovingBody ahead{{1, 0}, {0, 0}, 0.25};
+  const sim::MovingBody behind{{-1, 0}, {0, 0}, 0.25};
+  const Point2 fa = crowd.person_force({0, 0}, {1, 0}, ahead);
+  const Point2 fb = crowd.person_force({0, 0}, {1, 0}, behind);
+  EXPECT_LT(fa.x_m, 0.0) << "pushed back";
+  EXPECT_GT(fb.x_m, 0.0) << "pushed forward";
+  EXPECT_NEAR(fb.x_m, -0.5 * fa.x_m, 1e-6);
+  // V0/sigma exp(-b/sigma) with b = |r| for a standing person.
+  EXPECT_NEAR(-fa.x_m, 2.1 / 0.3 * std::exp(-1.0 / 0.3), 1e-4);
+}
+
+TEST(SocialForce, SpeedIsCappedAt1_3TimesTheDesired) {
+  sim::Crowd crowd;
+  sim::Pedestrian p;
+  p.velocity = {5, 0};
+  p.desired_speed_mps = 1.0;
+  p.goals = {{100, 0}};
+  crowd.add(p);
+  crowd.step(0.01, sim::StaticWorld{}, {});
+  EXPECT_NEAR(std::hypot(crowd.people()[0].velocity.x_m, crowd.people()[0].velocity.y_m), 1.3,
+              1e-9);
+}
+
+// ---- VLP-16 emulation, read by the real decoder -----------------------------------------------
+
+TEST(SimVlp16, PacketsAtTheRealRateWithTheAzimuthAdvancingAt10Hz) {
+  sim::SimVlp16 lidar;
+  sim::StaticWorld w;
+  std::vector<std::pair<vlp16::RawDataPacket, hal::Nanos>> got;
+  auto sink = [&](std::span<const uint8_t> bytes, hal::Nanos at) {
+    vlp16::RawDataPacket p;
+    ASSERT_EQ(vlp16::parse_data_packet(bytes, p), vlp16::DecodeError::kNone);
+    got.emplace_back(p, at);
+  };
+  const auto still = [](hal::Nanos) { return Pose2{}; };
+  for (int ms = 0; ms <= 1000; ms += 5)
+    lidar.step(hal::Nanos(std::chrono::milliseconds(ms)), w, {}, still, sink);
+  EXPECT_NEAR(static_cast<double>(got.size()), 1e6 / sim::SimVlp16::kPacketUs, 1.0) << "754/s";
+  for (size_t i = 1; i < got.size(); ++i) {
+    const int step =
+        (got[i].first.blocks[0].azimuth - got[i - 1].first.blocks[0].azimuth + 36000) % 36000;
+    EXPECT_NEAR(step, 1327.104 * 0.36, 1.0) << i;  // 0.01 degree per packet at 600 rpm
+    EXPECT_NEAR(got[i].first.timestamp_us - got[i - 1].first.timestamp_us, 1327.104, 1.0) << i;
+    EXPECT_LE(got[i].second.count() - got[i - 1].second.count(), 1327105);
+  }
+}
+
+TEST(SimVlp16, AWallAheadDecodesAtItsDistanceAndTheGroundBelowTheSensor) {
+  sim::SimVlp16Config cfg;
+  cfg.range_noise_m = 0.0;
+  sim::SimVlp16 lidar(cfg);
+  sim::StaticWorld w;
+  w.add_wall({5.1, -20}, {5.1, 20});  // 5 m ahead of the sensor (mounted 0.10 m ahead)
+  std::vector<vlp16::Point> pts(vlp16::kReturnsPerPacket);
+  int wall = 0, ground = 0, behind = 0;
+  auto sink = [&](std::span<const uint8_t> bytes, hal::Nanos) {
+    vlp16::RawDataPacket p;
+    ASSERT_EQ(vlp16::parse_data_packet(bytes, p), vlp16::DecodeError::kNone);
+    const size_t n = vlp16::decode_points(p, {}, pts);
+    for (size_t i = 0; i < n; ++i) {
+      const double x = pts[i].x_m, y = pts[i].y_m, z = pts[i].z_m;
+      const auto& q = pts[i];
+      if (std::abs(y) < 1.0 && x > 0) {
+        if (z > -0.44) {
+          EXPECT_NEAR(q.x_m, 5.0, 0.02) << "laser " << int(q.laser);
+          ++wall;
+        } else {
+          EXPECT_NEAR(q.z_m, -0.45, 0.01) << "the ground, 0.45 m below the sensor";
+          ++ground;
+        }
+      }
+      if (x < -0.5 && std::abs(y) < 1.0) ++behind;
+    }
+  };
+  for (int ms = 5; ms <= 200; ms += 5)
+    lidar.step(hal::Nanos(std::chrono::milliseconds(ms)), w, {}, [](hal::Nanos) { return Pose2{}; },
+               sink);
+  EXPECT_GT(wall, 100);
+  EXPECT_GT(ground, 100);
+  EXPECT_GT(behind, 0) << "only ground behind";
+}
+
+TEST(SimVlp16, PeopleAreCylindersThatLowBeamsHitAndHighBeamsPass) {
+  sim::SimVlp16Config cfg;
+  cfg.range_noise_m = 0.0;
+  sim::SimVlp16 lidar(cfg);
+  const sim::StaticWorld empty;
+  const std::vector<sim::Cylinder> person{{{2.1, 0.0}, 0.25, 1.0}};  // 1 m tall, 2 m ahead
+  std::vector<vlp16::Point> pts(vlp16::kReturnsPerPacket);
+  double max_z = -1;
+  int hits = 0;
+  auto sink = [&](std::span<const uint8_t> bytes, hal::Nanos) {
+    vlp16::RawDataPacket p;
+    (void)vlp16::parse_data_packet(bytes, p);
+    const size_t n = vlp16::decode_points(p, {}, pts);
+    for (size_t i = 0; i < n; ++i) {
+      const double x = pts[i].x_m, y = pts[i].y_m, z = pts[i].z_m;
+      if (std::abs(y) < 0.3 && x > 1.5 && x < 2.1 && z > -0.4) {
+        ++hits;
+        max_z = std::max(max_z, static_cast<double>(pts[i].z_m));
+        EXPECT_NEAR(std::hypot(x - 2.0, y), 0.25, 0.01) << "on the surface (centre 2.0 m ahead)";
+      }
+    }
+  };
+  for (int ms = 5; ms <= 100; ms += 5)
+    lidar.step(hal::Nanos(std::chrono::milliseconds(ms)), empty, person,
+               [](hal::Nanos) { return Pose2{}; }, sink);
+  EXPECT_GT(hits, 20);
+  EXPECT_LE(max_z, 1.0 - 0.45 + 0.01) << "nothing above the person's head";
+}
+
+// ---- the world: tracker frames the daemon's person frame reads back ---------------------------
+
+TEST(SimWorld, TrackerFramesPlaceThePersonWhereTheWorldHasThem) {
+  hal::SimClock clock;
+  sim::Scenario s;
+  s.name = "t";
+  s.person = sim::walk({{{2.0, 1.0}}, {{2.0, 5.0}, 1.0}}, 0.0);  // walking +y
+  s.robot_start = Pose2{0.5, 0.5, 0.3};
+  sim::SimWorldConfig cfg;
+  cfg.tracker_extrinsics.source_xyz_m = {0.0, 0.0, 0.35};
+  cfg.tracker_extrinsics.source_rpy_rad = {0.0, 0.0, std::numbers::pi};
+  sim::SimWorld world(s, cfg, clock);
+  auto link = world.take_tracker_link();
+  const amfitrack::PersonFrame frame(cfg.tracker_extrinsics);
+  world.step(0ms);
+  world.step(500ms);
+  int frames = 0;
+  while (auto p = link->receive()) {
+    const auto parsed = amfitrack::decode_payload(*p);
+    if (!parsed.payload) continue;
+    const auto* m = std::get_if<amfitrack::SensorMeasurement>(&*parsed.payload);
+    if (m == nullptr) continue;
+    const auto person = frame.to_base(*m);
+    ASSERT_TRUE(person);
+    ++frames;
+    if (frames == 55) {  // ~0.46 s
+      const Pose2 truth = world.robot_pose().inverse() * world.person_pose();
+      EXPECT_NEAR(person->x_m, truth.x_m, 0.05);
+      EXPECT_NEAR(person->y_m, truth.y_m, 0.05);
+      EXPECT_NEAR(person->z_m, 1.0, 1e-3);
+      EXPECT_NEAR(core::wrap_angle(person->heading_rad - truth.theta_rad), 0.0, 1e-3);
+    }
+  }
+  EXPECT_NEAR(frames, 60, 1) << "120 Hz";
+}
+
+// ---- the in-process datagram link ---------------------------------------------------------------
+
+TEST(DatagramQueue, DeliversWhatHasArrivedByNowAndCountsOverflow) {
+  hal::DatagramQueue q(3);
+  const std::array<uint8_t, 2> a{1, 2};
+  q.push(a, hal::Nanos(10));
+  q.push(a, hal::Nanos(20));
+  q.push(a, hal::Nanos(30));
+  q.push(a, hal::Nanos(40));  // over capacity
+  std::vector<int64_t> seen;
+  q.drain(100, hal::Nanos(25), [&](const hal::UdpDatagram& d) {
+    seen.push_back(d.stamp.count());
+    EXPECT_EQ(d.bytes.size(), 2U);
+  });
+  EXPECT_EQ(seen, (std::vector<int64_t>{10, 20})) << "not the one arriving at 30";
+  EXPECT_EQ(q.stats().kernel_drops, 1U);
+  EXPECT_EQ(q.stats().datagrams, 2U);
+  q.drain(100, hal::Nanos(100), [&](const hal::UdpDatagram& d) { seen.push_back(d.stamp.count()); });
+  EXPECT_EQ(seen.size(), 3U);
+}
+
+// ---- run metrics -------------------------------------------------------------------------------
+
+TEST(RunMetrics, UncomfortableTimeFarFailureAndCollision) {
+  sim::RunMetricsRecorder r;
+  sim::DaemonView v;
+  v.active = true;
+  const Pose2 person{0, 0, 0};
+  // 1 s at 0.3 m (intimate zone, inside the ellipse), then 6 s at 2.5 m behind.
+  double t = 0;
+  for (int i = 0; i < 100; ++i, t += 0.01)
+    r.record(t, 0.01, Pose2{-0.3, 0, 0}, person, {}, 5.0, 1.0, v);
+  for (int i = 0; i < 600; ++i, t += 0.01)
+    r.record(t, 0.01, Pose2{-2.5, 0, 0}, person, {}, 5.0, 1.0, v);
+  auto m = r.finish();
+  EXPECT_NEAR(m.uncomfortable_s, 1.0, 0.011);
+  EXPECT_NEAR(m.inside_ellipse_s, 1.0, 0.011);
+  EXPECT_FALSE(m.success);
+  EXPECT_NE(m.failure.find("from the person for 5 s"), std::string::npos) << m.failure;
+  EXPECT_FALSE(m.collision);
+  EXPECT_NEAR(m.side_time_s[4], 7.0, 0.02) << "behind";
+
+  sim::RunMetricsRecorder c;
+  c.record(0.0, 0.01, Pose2{-1, 0, 0}, person, {}, 0.5, 1.0, v);
+  c.record(0.01, 0.01, Pose2{-1, 0, 0}, person, {}, 0.0, 1.0, v);
+  m = c.finish();
+  EXPECT_TRUE(m.collision);
+  EXPECT_FALSE(m.success);
+  EXPECT_NE(m.failure.find("obstacle"), std::string::npos);
+}
+
+TEST(RunMetrics, TrackingErrorIsInTheRobotFrame) {
+  sim::RunMetricsRecorder r;
+  sim::DaemonView v;
+  v.active = true;
+  v.has_goal = true;
+  v.robot_odom = Pose2{1, 1, std::numbers::pi / 2};
+  v.goal_odom = Pose2{1, 1.3, std::numbers::pi / 2 + 0.1};  // 0.3 m ahead of the robot
+  for (int i = 0; i < 10; ++i)
+    r.record(0.01 * i, 0.01, Pose2{}, Pose2{5, 0, 0}, {}, 5.0, 5.0, v);
+  const auto m = r.finish();
+  EXPECT_NEAR(m.rmse_ex_m, 0.3, 1e-9);
+  EXPECT_NEAR(m.rmse_ey_m, 0.0, 1e-9);
+  EXPECT_NEAR(m.rmse_etheta_rad, 0.1, 1e-9);
+}
+
+TEST(RunMetrics, SectorsNameTheSidesOfThePerson) {
+  EXPECT_EQ(sim::sector_of(0.0), 0);
+  EXPECT_STREQ(sim::sector_name(sim::sector_of(std::numbers::pi / 2)), "left");
+  EXPECT_STREQ(sim::sector_name(sim::sector_of(std::numbers::pi)), "behind");
+  EXPECT_STREQ(sim::sector_name(sim::sector_of(-std::numbers::pi)), "behind");
+  EXPECT_STREQ(sim::sector_name(sim::sector_of(-std::numbers::pi / 2)), "right");
+}
