@@ -5,6 +5,7 @@
 #include <csignal>
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -151,4 +152,79 @@ TEST(Companiond, RefusesAPolicyFileThatDoesNotLoad) {
   EXPECT_EQ(*code, 1);
   EXPECT_NE(p.output().find(policy + ": policy file: truncated header"), std::string::npos)
       << p.output();
+}
+
+// ---- the main job: companiond on the simulated world ---------------------------------------
+
+namespace {
+std::string slurp(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+}  // namespace
+
+TEST(CompanionSim, RealTimeRunAccompaniesThenSigtermStopsTheBaseAndWritesTheReport) {
+  test_support::NotifySocket sock;
+  ASSERT_TRUE(sock.ok());
+  sock.export_env();
+  const std::string dir = ::testing::TempDir() + "companion-sim-rt";
+  ChildProcess p({COMPANIOND_PATH, "--config", COMPANION_SIM_CONFIG, "--scenario", "open",
+                  "--live", "--log-sink", "console", "--status-file", dir + "-status.json",
+                  "--report", dir});
+  unsetenv("NOTIFY_SOCKET");
+  ASSERT_TRUE(p.started());
+  ASSERT_TRUE(sock.receive_containing("READY=1", 10s).has_value()) << p.output();
+  // ACTIVE (armed on the simulated devices), then a few more status lines: the person walks from
+  // 4 s on and the robot with them.
+  for (int i = 0; i < 6; ++i) {
+    ASSERT_TRUE(sock.receive_containing("STATUS=ACTIVE", 15s).has_value()) << p.output();
+  }
+  const std::string status = slurp(dir + "-status.json");
+  EXPECT_NE(status.find("\"state\": \"ACTIVE\""), std::string::npos) << status;
+  EXPECT_NE(status.find("\"name\": \"control\""), std::string::npos) << status;
+  EXPECT_NE(status.find("\"selector\": \"objective\""), std::string::npos) << status;
+  p.signal(SIGTERM);
+  const auto code = p.wait(15s);
+  ASSERT_TRUE(code.has_value());
+  EXPECT_EQ(*code, 0);
+  const std::string out = p.output();
+  EXPECT_NE(out.find("SIGTERM: stopping the robot"), std::string::npos) << out;
+  EXPECT_NE(out.find("zero velocity commanded; exiting"), std::string::npos) << out;
+  EXPECT_NE(out.find("base velocity 0.000 0.000 0.000"), std::string::npos) << out;
+  EXPECT_NE(out.find("] ACTIVE | objective"), std::string::npos) << "live status line\n" << out;
+  EXPECT_NE(slurp(dir + "/report.md").find("| collision | no |"), std::string::npos);
+  EXPECT_NE(slurp(dir + "/trajectory.svg").find("<polyline"), std::string::npos);
+}
+
+TEST(CompanionSim, SimulatedClockRunsAreIdentical) {
+  auto run = [](const std::string& dir) {
+    ChildProcess p({COMPANIOND_PATH, "--config", COMPANION_SIM_CONFIG, "--scenario", "crossing",
+                    "--duration-s", "9", "--sim-clock", "--report", dir, "--log-sink", "console"});
+    EXPECT_TRUE(p.started());
+    const auto code = p.wait(120s);
+    EXPECT_TRUE(code.has_value());
+    EXPECT_EQ(code.value_or(-1), 0) << p.output();
+    EXPECT_NE(p.output().find("crossing: SUCCESS"), std::string::npos) << p.output();
+    return slurp(dir + "/samples.csv");
+  };
+  const std::string a = run(::testing::TempDir() + "companion-sim-a");
+  const std::string b = run(::testing::TempDir() + "companion-sim-b");
+  EXPECT_GT(a.size(), 2000U);
+  EXPECT_EQ(a, b) << "same scenario, same seed: the same trajectories";
+}
+
+TEST(CompanionSim, RefusesAnUnknownScenarioAndABadPedestrianFile) {
+  ChildProcess p({COMPANIOND_PATH, "--config", COMPANION_SIM_CONFIG, "--scenario", "moon"});
+  ASSERT_TRUE(p.started());
+  EXPECT_EQ(p.wait(10s), 2);
+  EXPECT_NE(p.output().find("unknown scenario 'moon'; built-in: open"), std::string::npos)
+      << p.output();
+  const std::string bad = write_temp("peds.txt", "0 1 2 3\n10 1 x 3\n");
+  ChildProcess q({COMPANIOND_PATH, "--config", COMPANION_SIM_CONFIG, "--pedestrians", bad});
+  ASSERT_TRUE(q.started());
+  EXPECT_EQ(q.wait(10s), 2);
+  EXPECT_NE(q.output().find(bad + ":2: column 3 is not a number: 'x'"), std::string::npos)
+      << q.output();
 }
