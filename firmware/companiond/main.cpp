@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "amfitrack/open_link.hpp"
+#include "firmware/capture_recorder.hpp"
 #include "firmware/config/config_loader.hpp"
 #include "firmware/daemon.hpp"
 #include "firmware/logging.hpp"
@@ -50,6 +51,7 @@ int run(int argc, char** argv) {
   double duration_s = 0.0;
   std::string sink_name = "auto";
   std::string status_file;
+  std::string record_dir;
   bool live = false;
   bool list_scenarios = false;
   companiond::SimOptions sim_opts;
@@ -63,6 +65,8 @@ int run(int argc, char** argv) {
       ->check(CLI::IsMember({"auto", "console", "journald"}));
   app.add_option("--status-file", status_file,
                  "write the machine-readable status (JSON) here every second, atomically");
+  app.add_option("--record", record_dir,
+                 "write a capture of every device's traffic here (candump, amfi0 log, pcap)");
   app.add_flag("--live", live, "print a one-line live status every second on stdout");
   auto* simg = app.add_option_group("simulation", "with devices 'sim' (config/sim.yaml)");
   simg->add_option("--scenario", sim_opts.scenario, "built-in scenario (--list-scenarios)");
@@ -168,6 +172,32 @@ int run(int argc, char** argv) {
   hal::LinuxClock clock;
   firmware::Daemon daemon(cfg, notifier);
   if (!status_file.empty()) daemon.set_status_file(status_file);
+  // --record: every device end is wrapped by a tap before the daemon gets it.
+  std::unique_ptr<firmware::CaptureRecorder> recorder;
+  if (!record_dir.empty()) {
+    std::string error;
+    recorder = firmware::CaptureRecorder::open(
+        record_dir, cfg, scenario ? "simulated world: " + scenario->name : "robot", error);
+    if (!recorder) {
+      spdlog::critical("{}", error);
+      firmware::shutdown_logging();
+      return 2;
+    }
+    spdlog::info("recording the devices' traffic into {}", record_dir);
+  }
+  auto base_end = [&](std::unique_ptr<hal::CanBus> bus) {
+    return recorder ? recorder->wrap_base(std::move(bus), clock) : std::move(bus);
+  };
+  auto tracker_end = [&](std::unique_ptr<amfitrack::PacketLink> link) {
+    return recorder ? recorder->wrap_tracker(std::move(link), clock) : std::move(link);
+  };
+  auto lidar_end = [&](std::unique_ptr<hal::DatagramSource> source) {
+    if (!recorder) return source;
+    std::string error;
+    auto wrapped = recorder->wrap_lidar(std::move(source), error);
+    if (!error.empty()) spdlog::error("--record: lidar not recorded: {}", error);
+    return wrapped;
+  };
   std::unique_ptr<sim::WorldThread> world;
   if (scenario) {
     world = std::make_unique<sim::WorldThread>(
@@ -182,7 +212,7 @@ int run(int argc, char** argv) {
     auto opened = hal::open_can(base_uri, clock, scout_mini::feedback_ids());
     if (!opened.bus) {
       spdlog::error("base: cannot open it: {}", opened.error);  // the error names the URI
-    } else if (!daemon.attach_base(std::move(opened.bus))) {
+    } else if (!daemon.attach_base(base_end(std::move(opened.bus)))) {
       spdlog::critical("task table: base and control tasks must share a rate group");
       firmware::shutdown_logging();
       return 1;
@@ -190,7 +220,7 @@ int run(int argc, char** argv) {
       spdlog::info("base: Scout Mini on {}", base_uri);
     }
   } else if (base_uri == "sim") {
-    if (!daemon.attach_base(world->world().take_base_bus())) {
+    if (!daemon.attach_base(base_end(world->world().take_base_bus()))) {
       spdlog::critical("task table: base and control tasks must share a rate group");
       firmware::shutdown_logging();
       return 1;
@@ -208,13 +238,13 @@ int run(int argc, char** argv) {
       firmware::shutdown_logging();
       return 1;
     }
-    daemon.attach_tracker(std::make_unique<amfitrack::ReconnectingLink>(
+    daemon.attach_tracker(tracker_end(std::make_unique<amfitrack::ReconnectingLink>(
         [u = *uri]() { return amfitrack::open_link(u); }, firmware::tracker_reconnect_config(cfg),
-        amfitrack::OpenMode::kBackground));
+        amfitrack::OpenMode::kBackground)));
     spdlog::info("tracker: Amfitrack on {} (sensor TX id {})", tracker_uri,
                  cfg.tracker.sensor_tx_id);
   } else if (tracker_uri == "sim") {
-    daemon.attach_tracker(world->world().take_tracker_link());
+    daemon.attach_tracker(tracker_end(world->world().take_tracker_link()));
     spdlog::info("tracker: simulated Amfitrack (Amfiprot packets, sensor TX id {})",
                  cfg.tracker.sensor_tx_id);
   }
@@ -239,10 +269,10 @@ int run(int argc, char** argv) {
             opened.receiver->buffer_bytes(), cfg.lidar.receive_buffer_bytes);
       }
       spdlog::info("lidar: VLP-16 on {}:{}", ep.address, opened.receiver->port());
-      daemon.attach_lidar(std::move(opened.receiver));
+      daemon.attach_lidar(lidar_end(std::move(opened.receiver)));
     }
   } else if (lidar_uri == "sim") {
-    daemon.attach_lidar(world->world().take_lidar_source());
+    daemon.attach_lidar(lidar_end(world->world().take_lidar_source()));
     spdlog::info("lidar: simulated VLP-16 (1206-byte packets ray cast from the world)");
   }
   // The learned selector, when configured: it must load completely, or the daemon does not start.

@@ -208,7 +208,9 @@ void Daemon::attach_tracker(std::unique_ptr<amfitrack::PacketLink> link) {
   tracker_link_ = std::move(link);
   tracker_ = std::make_unique<amfitrack::Amfitrack>(*tracker_link_, amfitrack_config(cfg_));
   // Resolved once here, not per run: a reconnecting link also reports why it is down.
-  tracker_reconnecting_ = dynamic_cast<const amfitrack::ReconnectingLink*>(tracker_link_.get());
+  const amfitrack::PacketLink* inner = tracker_link_.get();
+  if (const auto* tap = dynamic_cast<const amfitrack::TapLink*>(inner)) inner = &tap->inner();
+  tracker_reconnecting_ = dynamic_cast<const amfitrack::ReconnectingLink*>(inner);
 }
 
 void Daemon::tracker_link_events(Nanos now) {

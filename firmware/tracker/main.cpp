@@ -19,6 +19,7 @@
 #include <numbers>
 #include <string>
 
+#include "amfitrack/tap_link.hpp"
 #include "amfitrack/amfitrack.hpp"
 #include "amfitrack/open_link.hpp"
 #include "firmware/tool_console.hpp"
@@ -39,26 +40,6 @@ using namespace std::chrono_literals;
 constexpr int kExitFail = 1;
 constexpr int kExitNoDevice = 2;
 constexpr Nanos kPollPeriod = 2ms;  // faster than the 120 Hz frames: no queue builds up
-
-// Passes packets through and shows each received one to a callback (for `record`).
-class TapLink final : public am::PacketLink {
- public:
-  TapLink(am::PacketLink& inner, std::function<void(const am::Packet&)> on_receive)
-      : inner_(inner), on_receive_(std::move(on_receive)) {}
-  void service(Nanos now) override { inner_.service(now); }
-  std::optional<am::Packet> receive() override {
-    auto p = inner_.receive();
-    if (p) on_receive_(*p);
-    return p;
-  }
-  bool send(const am::Packet& p) override { return inner_.send(p); }
-  [[nodiscard]] bool failed() const override { return inner_.failed(); }
-  [[nodiscard]] am::FramingStats framing_stats() const override { return inner_.framing_stats(); }
-
- private:
-  am::PacketLink& inner_;
-  std::function<void(const am::Packet&)> on_receive_;
-};
 
 // A live packet source: a device link, or the simulated tracker stepped in the loop.
 struct Live {
@@ -286,7 +267,7 @@ int cmd_record(Live& live, const std::string& path, double duration_s) {
     return kExitNoDevice;
   }
   uint64_t n = 0;
-  TapLink tap(*live.link, [&](const am::Packet& p) {
+  am::TapLink tap(*live.link, [&](const am::Packet& p) {
     timespec ts{};
     clock_gettime(CLOCK_REALTIME, &ts);  // wall-clock stamps, as candump -l writes
     writer.write({ts.tv_sec, ts.tv_nsec, "amfi0", am::encode_packet(p)});

@@ -228,3 +228,20 @@ TEST(CompanionSim, RefusesAnUnknownScenarioAndABadPedestrianFile) {
   EXPECT_NE(q.output().find(bad + ":2: column 3 is not a number: 'x'"), std::string::npos)
       << q.output();
 }
+
+TEST(CompanionSim, RecordWritesACaptureOtherToolsRead) {
+  const std::string dir = ::testing::TempDir() + "companion-capture";
+  ChildProcess p({COMPANIOND_PATH, "--config", COMPANION_SIM_CONFIG, "--scenario", "open",
+                  "--duration-s", "3", "--record", dir, "--log-sink", "console"});
+  ASSERT_TRUE(p.started());
+  ASSERT_EQ(p.wait(30s), 0) << p.output();
+  const std::string can = slurp(dir + "/base.candump");
+  EXPECT_NE(can.find(" can0 421#01"), std::string::npos) << "CAN mode request";
+  EXPECT_NE(can.find(" can0 111#"), std::string::npos) << "motion commands";
+  EXPECT_NE(can.find(" can0 211#"), std::string::npos) << "base feedback";
+  EXPECT_NE(slurp(dir + "/tracker.log").find(" amfi0 "), std::string::npos);
+  const std::string pcap = slurp(dir + "/lidar.pcap");
+  ASSERT_GT(pcap.size(), 1000U * 1248U) << "~750 packets per second";
+  EXPECT_EQ(static_cast<uint8_t>(pcap[0]), 0xD4) << "classic pcap, little-endian magic";
+  EXPECT_NE(slurp(dir + "/capture.yaml").find("lidar: lidar.pcap"), std::string::npos);
+}

@@ -11,6 +11,7 @@
 
 #include "amfitrack/amfitrack.hpp"
 #include "amfitrack/person_frame.hpp"
+#include "amfitrack/tap_link.hpp"
 #include "core/channel/latest_value.hpp"
 #include "core/channel/snapshot_channel.hpp"
 #include "core/control/mppi.hpp"
