@@ -10,7 +10,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build ccache pkg-config git
   libeigen3-dev libspdlog-dev libfmt-dev libserialport-dev libhidapi-dev libsystemd-dev
-  libpcap-dev libyaml-cpp-dev libcli11-dev
+  libpcap-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   clang clang-format clang-tidy
   systemd can-utils util-linux python3 tcpdump

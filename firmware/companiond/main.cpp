@@ -23,6 +23,7 @@
 #include "hal/realtime.hpp"
 #include "hal/sd_notify.hpp"
 #include "sim/sim_run.hpp"
+#include "show_status.hpp"
 #include "sim_mode.hpp"
 
 namespace {
@@ -52,6 +53,7 @@ int run(int argc, char** argv) {
   std::string sink_name = "auto";
   std::string status_file;
   std::string record_dir;
+  std::string show_status_path;
   bool live = false;
   bool list_scenarios = false;
   companiond::SimOptions sim_opts;
@@ -67,6 +69,8 @@ int run(int argc, char** argv) {
                  "write the machine-readable status (JSON) here every second, atomically");
   app.add_option("--record", record_dir,
                  "write a capture of every device's traffic here (candump, amfi0 log, pcap)");
+  app.add_option("--show-status", show_status_path,
+                 "print the status file a running companiond writes (--status-file) and exit");
   app.add_flag("--live", live, "print a one-line live status every second on stdout");
   auto* simg = app.add_option_group("simulation", "with devices 'sim' (config/sim.yaml)");
   simg->add_option("--scenario", sim_opts.scenario, "built-in scenario (--list-scenarios)");
@@ -85,6 +89,7 @@ int run(int argc, char** argv) {
                    "write the run report here at the end (report.md, trajectory.svg, ...)");
   CLI11_PARSE(app, argc, argv);
 
+  if (!show_status_path.empty()) return companiond::show_status(show_status_path);
   if (list_scenarios) {
     for (const auto& s : sim::builtin_scenarios())
       std::cout << s.name << "  " << s.description << "\n";

@@ -182,9 +182,17 @@ TEST(CompanionSim, RealTimeRunAccompaniesThenSigtermStopsTheBaseAndWritesTheRepo
     ASSERT_TRUE(sock.receive_containing("STATUS=ACTIVE", 15s).has_value()) << p.output();
   }
   const std::string status = slurp(dir + "-status.json");
-  EXPECT_NE(status.find("\"state\": \"ACTIVE\""), std::string::npos) << status;
-  EXPECT_NE(status.find("\"name\": \"control\""), std::string::npos) << status;
-  EXPECT_NE(status.find("\"selector\": \"objective\""), std::string::npos) << status;
+  EXPECT_NE(status.find("\"state\":\"ACTIVE\""), std::string::npos) << status;
+  EXPECT_NE(status.find("\"name\":\"control\""), std::string::npos) << status;
+  EXPECT_NE(status.find("\"selector\":\"objective\""), std::string::npos) << status;
+  {
+    ChildProcess show({COMPANIOND_PATH, "--show-status", dir + "-status.json"});
+    ASSERT_TRUE(show.started());
+    EXPECT_EQ(show.wait(10s), 0);
+    const std::string text = show.output();
+    EXPECT_NE(text.find("safety   ACTIVE"), std::string::npos) << text;
+    EXPECT_NE(text.find("\ncontrol "), std::string::npos) << "the task table" << text;
+  }
   p.signal(SIGTERM);
   const auto code = p.wait(15s);
   ASSERT_TRUE(code.has_value());

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -28,30 +30,6 @@ struct Bounds {
     y1 = std::max(y1, y);
   }
 };
-
-std::string json_escape(const std::string& s) {
-  std::string out;
-  for (const char c : s) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          out += fmt::format("\\u{:04x}", static_cast<int>(c));
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out;
-}
 
 std::string xml_escape(const std::string& s) {
   std::string out;
@@ -223,29 +201,37 @@ std::string report_markdown(const RunReportInputs& in) {
 
 std::string metrics_json(const RunReportInputs& in) {
   const RunMetrics& m = *in.metrics;
-  std::string sides;
-  for (double t : m.side_time_s)
-    sides += fmt::format("{}{:.3f}", sides.empty() ? "" : ", ", t);
-  return fmt::format(
-      "{{\n  \"scenario\": \"{}\",\n  \"success\": {},\n  \"failure\": \"{}\",\n"
-      "  \"collision\": {},\n  \"duration_s\": {:.3f},\n  \"active_s\": {:.3f},\n"
-      "  \"uncomfortable_s\": {:.3f},\n  \"inside_ellipse_s\": {:.3f},\n"
-      "  \"rmse_ex_m\": {:.4f},\n  \"rmse_ey_m\": {:.4f},\n  \"rmse_etheta_rad\": {:.4f},\n"
-      "  \"min_person_distance_m\": {:.3f},\n  \"mean_person_distance_m\": {:.3f},\n"
-      "  \"max_person_distance_m\": {:.3f},\n  \"longest_far_s\": {:.3f},\n"
-      "  \"min_static_clearance_m\": {:.3f},\n  \"min_people_clearance_m\": {:.3f},\n"
-      "  \"rms_jerk\": {:.3f},\n  \"stops\": {},\n  \"side_time_s\": [{}],\n"
-      "  \"policy_ms_p50\": {:.4f},\n  \"policy_ms_p99\": {:.4f},\n"
-      "  \"control_ms_p50\": {:.4f},\n  \"control_ms_p99\": {:.4f}\n}}\n",
-      json_escape(in.scenario->name), m.success, json_escape(m.failure), m.collision, m.duration_s,
-      m.active_s, m.uncomfortable_s, m.inside_ellipse_s, m.rmse_ex_m, m.rmse_ey_m,
-      m.rmse_etheta_rad, m.min_person_distance_m, m.mean_person_distance_m,
-      m.max_person_distance_m, m.longest_far_s, std::min(m.min_static_clearance_m, 1e6),
-      std::min(m.min_people_clearance_m, 1e6), m.rms_jerk, m.stops, sides,
-      in.policy_ms.empty() ? 0.0 : quantile(in.policy_ms, 0.5),
-      in.policy_ms.empty() ? 0.0 : quantile(in.policy_ms, 0.99),
-      in.control_ms.empty() ? 0.0 : quantile(in.control_ms, 0.5),
-      in.control_ms.empty() ? 0.0 : quantile(in.control_ms, 0.99));
+  auto q = [](const std::vector<double>& v, double p) {
+    return v.empty() ? nlohmann::json(nullptr) : nlohmann::json(quantile(v, p));
+  };
+  auto clearance = [](double v) { return v > 1e6 ? nlohmann::json(nullptr) : nlohmann::json(v); };
+  const nlohmann::json j = {
+      {"scenario", in.scenario->name},
+      {"success", m.success},
+      {"failure", m.failure},
+      {"collision", m.collision},
+      {"duration_s", m.duration_s},
+      {"active_s", m.active_s},
+      {"tracking_s", m.tracking_s},
+      {"uncomfortable_s", m.uncomfortable_s},
+      {"inside_ellipse_s", m.inside_ellipse_s},
+      {"rmse_ex_m", m.rmse_ex_m},
+      {"rmse_ey_m", m.rmse_ey_m},
+      {"rmse_etheta_rad", m.rmse_etheta_rad},
+      {"min_person_distance_m", m.min_person_distance_m},
+      {"mean_person_distance_m", m.mean_person_distance_m},
+      {"max_person_distance_m", m.max_person_distance_m},
+      {"longest_far_s", m.longest_far_s},
+      {"min_static_clearance_m", clearance(m.min_static_clearance_m)},
+      {"min_people_clearance_m", clearance(m.min_people_clearance_m)},
+      {"rms_jerk_mps3", m.rms_jerk},
+      {"stops", m.stops},
+      {"side_time_s", m.side_time_s},
+      {"policy_ms_p50", q(in.policy_ms, 0.5)},
+      {"policy_ms_p99", q(in.policy_ms, 0.99)},
+      {"control_ms_p50", q(in.control_ms, 0.5)},
+      {"control_ms_p99", q(in.control_ms, 0.99)}};
+  return j.dump(2) + "\n";
 }
 
 std::string samples_csv(const std::vector<RunSample>& samples) {
