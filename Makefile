@@ -5,7 +5,7 @@
 
 JOBS ?= $(shell nproc)
 TSAN_TARGETS := test_core_channel test_hal_clock test_firmware_executor test_firmware_daemon \
-  test_drivers_amfitrack_threads
+  test_drivers_amfitrack_threads test_sim_realtime
 FUZZERS := fuzz_candump_line fuzz_slcan_stream fuzz_scout_decode fuzz_amfiprot fuzz_vlp16 \
   fuzz_pedestrian_dataset
 FUZZ_SECONDS ?= 10

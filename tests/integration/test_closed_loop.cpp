@@ -11,6 +11,7 @@
 #include "firmware/config/config_loader.hpp"
 #include "firmware/daemon.hpp"
 #include "scout_mini/scout_codec.hpp"
+#include "sim/pedestrian_dataset.hpp"
 #include "sim/sim_run.hpp"
 
 using sim::SimRunOptions;
@@ -148,6 +149,10 @@ struct Fault {
   core::Reason reason;
 };
 
+void PrintTo(const Fault& f, std::ostream* os) {
+  *os << f.name;
+}
+
 class InputFault : public testing::TestWithParam<Fault> {};
 
 TEST_P(InputFault, StopsTheRobotAndNamesTheReason) {
@@ -235,4 +240,25 @@ TEST(ClosedLoop, SameSeedSameCanOutputBitForBit) {
     ASSERT_EQ(a.can_out[i].id, b.can_out[i].id) << i;
     ASSERT_EQ(a.can_out[i].data, b.can_out[i].data) << "frame " << i;
   }
+}
+
+// ---- recorded pedestrians (scenario 11) ---------------------------------------------------------
+
+TEST(ClosedLoop, FollowsARecordedPersonThroughARecordedCrowd) {
+  const auto loaded = sim::load_pedestrian_dataset(
+      std::string(COMPANION_PEDESTRIANS) + "/crowds_zara01.txt", 0.4);
+  ASSERT_TRUE(loaded.ok) << loaded.error;
+  std::string error;
+  const auto s = sim::recorded_scenario(loaded.data, sim::longest_walk(loaded.data), &error);
+  ASSERT_TRUE(s) << error;
+  SimRunOptions o;
+  o.config = defaults();
+  o.scenario = *s;
+  o.duration_s = 20.0;
+  const auto r = sim::run_simulation(o);
+  print(s->name, r);
+  EXPECT_GT(r.metrics.tracking_s, 10.0);
+  EXPECT_LT(r.metrics.longest_far_s, 5.0) << "never lost";
+  EXPECT_LT(r.metrics.mean_person_distance_m, 1.6);
+  EXPECT_FALSE(r.metrics.collision) << r.metrics.failure;
 }
