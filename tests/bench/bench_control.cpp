@@ -51,13 +51,16 @@ struct Warm {
   core::Nanos t{0};
 };
 
-Warm& warm(int threads) {
-  static std::array<std::unique_ptr<Warm>, 3> cache;
-  auto& w = cache[static_cast<size_t>(threads)];
+// `min_ess`: the shipped configuration floors the effective sample size at 50 (a temperature
+// search per step); 0 is the paper's fixed lambda = 1, the baseline in the same run.
+Warm& warm(int threads, int min_ess) {
+  static std::array<std::unique_ptr<Warm>, 6> cache;
+  auto& w = cache[static_cast<size_t>(threads * 2 + (min_ess > 0 ? 1 : 0))];
   if (!w) {
     w = std::make_unique<Warm>();
     core::MppiConfig cfg;  // K = 100, M = 2000
     cfg.threads = threads;
+    cfg.min_effective_samples = min_ess;
     w->mppi = std::make_unique<core::Mppi>(cfg);
     w->map = scene();
     for (int k = 0; k <= 100; ++k)
@@ -75,7 +78,7 @@ Warm& warm(int threads) {
 }
 
 void BM_MppiStep(benchmark::State& state) {
-  Warm& w = warm(static_cast<int>(state.range(0)));
+  Warm& w = warm(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
   for (auto _ : state) {
     w.in.now = w.t;
     const auto out = w.mppi->step(w.in);
@@ -85,8 +88,11 @@ void BM_MppiStep(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_MppiStep)
-    ->Arg(1)
-    ->Arg(2)
+    ->ArgNames({"threads", "min_ess"})
+    ->Args({1, 0})
+    ->Args({1, 50})
+    ->Args({2, 0})
+    ->Args({2, 50})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(1)
     ->Repetitions(100)
