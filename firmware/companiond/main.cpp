@@ -2,14 +2,13 @@
 // real-time scheduling, runs the task table until SIGTERM/SIGINT, then stops the robot before
 // exiting. See README.md ("Deploy on the robot", "Diagnose").
 #include <spdlog/spdlog.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <csignal>
 #include <cstdio>
 #include <iostream>
 #include <optional>
-
-#include <unistd.h>
 
 #include "amfitrack/open_link.hpp"
 #include "firmware/capture_recorder.hpp"
@@ -22,8 +21,8 @@
 #include "hal/net/udp_socket.hpp"
 #include "hal/realtime.hpp"
 #include "hal/sd_notify.hpp"
-#include "sim/sim_run.hpp"
 #include "show_status.hpp"
+#include "sim/sim_run.hpp"
 #include "sim_mode.hpp"
 
 namespace {
@@ -159,8 +158,8 @@ int run(int argc, char** argv) {
       return 2;
     }
     if (duration_s == 0) duration_s = scenario->duration_s;
-    spdlog::info("simulation: '{}' ({}), {:.1f} s, seed {}", scenario->name,
-                 scenario->description, duration_s, sim_opts.seed);
+    spdlog::info("simulation: '{}' ({}), {:.1f} s, seed {}", scenario->name, scenario->description,
+                 duration_s, sim_opts.seed);
     if (sim_opts.sim_clock) {
       if (cfg.devices.tracker != "sim" || cfg.devices.lidar != "sim" || cfg.devices.base != "sim") {
         spdlog::critical("--sim-clock needs every device to be 'sim'");

@@ -79,8 +79,9 @@ int show_status(const std::string& path) {
       "base     CAN mode {} E-stop {} RC {} bus-off {} faults 0x{:04X} write errors {}, feedback "
       "age {} ms, v {} {} {}\n",
       yes(b["can_mode"]), yes(b["estop"]), yes(b["rc_override"]), yes(b["bus_off"]),
-      b.value("fault_word", 0), num(b["write_errors"], "{:.0f}"), num(b["feedback_age_ms"], "{:.0f}"),
-      num(b["vx_mps"], "{:+.2f}"), num(b["vy_mps"], "{:+.2f}"), num(b["wz_radps"], "{:+.2f}"));
+      b.value("fault_word", 0), num(b["write_errors"], "{:.0f}"),
+      num(b["feedback_age_ms"], "{:.0f}"), num(b["vx_mps"], "{:+.2f}"), num(b["vy_mps"], "{:+.2f}"),
+      num(b["wz_radps"], "{:+.2f}"));
   const json& c = j["control"];
   std::cout << fmt::format(
       "control  tracking {} runs {} failures {} repairs {} ESS {}, command {} {} {}\n",
@@ -91,13 +92,13 @@ int show_status(const std::string& path) {
                            "rate", "nominal", "jitter p99", "run p50", "run p99", "run max",
                            "budget", "overruns", "skipped", "over budget");
   for (const auto& task : j.value("tasks", json::array())) {
-    std::cout << fmt::format("{:<11}{:>8}{:>8}{:>11}{:>9}{:>9}{:>9}{:>8}{:>9}{:>8}{:>12}\n",
-                             str(task["name"]), num(task["rate_hz"]),
-                             num(task["nominal_hz"], "{:.0f}"), num(task["jitter_p99_us"], "{:.0f}"),
-                             num(task["run_p50_us"], "{:.0f}"), num(task["run_p99_us"], "{:.0f}"),
-                             num(task["run_max_us"], "{:.0f}"), num(task["budget_us"], "{:.0f}"),
-                             num(task["overruns"], "{:.0f}"), num(task["skipped"], "{:.0f}"),
-                             num(task["over_budget"], "{:.0f}"));
+    std::cout << fmt::format(
+        "{:<11}{:>8}{:>8}{:>11}{:>9}{:>9}{:>9}{:>8}{:>9}{:>8}{:>12}\n", str(task["name"]),
+        num(task["rate_hz"]), num(task["nominal_hz"], "{:.0f}"),
+        num(task["jitter_p99_us"], "{:.0f}"), num(task["run_p50_us"], "{:.0f}"),
+        num(task["run_p99_us"], "{:.0f}"), num(task["run_max_us"], "{:.0f}"),
+        num(task["budget_us"], "{:.0f}"), num(task["overruns"], "{:.0f}"),
+        num(task["skipped"], "{:.0f}"), num(task["over_budget"], "{:.0f}"));
   }
   std::cout << "(times in microseconds; the same data: jq . " << path << ")\n";
   return 0;

@@ -125,10 +125,10 @@ void write_report(const std::string& dir, const sim::Scenario& scenario,
     spdlog::error("report: {}", err);
     return;
   }
-  spdlog::info("report: {}: {} (UT {:.2f} s, RMSE e_x {:.3f} e_y {:.3f} e_theta {:.3f}); picture {}",
-               dir + "/report.md", m.success ? "SUCCESS" : "FAILURE: " + m.failure,
-               m.uncomfortable_s, m.rmse_ex_m, m.rmse_ey_m, m.rmse_etheta_rad,
-               dir + "/trajectory.svg");
+  spdlog::info(
+      "report: {}: {} (UT {:.2f} s, RMSE e_x {:.3f} e_y {:.3f} e_theta {:.3f}); picture {}",
+      dir + "/report.md", m.success ? "SUCCESS" : "FAILURE: " + m.failure, m.uncomfortable_s,
+      m.rmse_ex_m, m.rmse_ey_m, m.rmse_etheta_rad, dir + "/trajectory.svg");
 }
 
 }  // namespace companiond

@@ -24,8 +24,7 @@ std::unique_ptr<CaptureRecorder> CaptureRecorder::open(const std::string& dir,
   std::ofstream meta(dir + "/capture.yaml");
   const auto now = std::chrono::system_clock::now().time_since_epoch();
   meta << "# companiond capture (DESIGN.md section 7)\n"
-       << fmt::format("created_unix_s: {:.3f}\n",
-                      std::chrono::duration<double>(now).count())
+       << fmt::format("created_unix_s: {:.3f}\n", std::chrono::duration<double>(now).count())
        << "files:\n"
        << "  base: base.candump      # candump -l format, interface can0\n"
        << "  tracker: tracker.log    # (sec.usec) amfi0 <hex of one Amfiprot packet>\n"

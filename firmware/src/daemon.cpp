@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <array>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <cmath>
 #include <limits>
 
 #include "firmware/task_table.hpp"
@@ -499,10 +499,11 @@ bool Daemon::run_controller(Nanos now, core::BodyVelocity& requested) {
   if (!out.ok) {
     ++control_state_.failures;
     if (!control_state_.numerical_failure) {
-      spdlog::error("control: MPPI numerical failure at run {} (robot {:.3f} {:.3f} {:.3f}, goal "
-                    "{:.3f} {:.3f} {:.3f}): stopping",
-                    control_state_.runs, robot.x_m, robot.y_m, robot.theta_rad,
-                    in.goal.x_m, in.goal.y_m, in.goal.theta_rad);
+      spdlog::error(
+          "control: MPPI numerical failure at run {} (robot {:.3f} {:.3f} {:.3f}, goal "
+          "{:.3f} {:.3f} {:.3f}): stopping",
+          control_state_.runs, robot.x_m, robot.y_m, robot.theta_rad, in.goal.x_m, in.goal.y_m,
+          in.goal.theta_rad);
     }
     control_state_.numerical_failure = true;  // the supervisor latches FAULT
     return false;

@@ -1,10 +1,9 @@
 // The daemon's machine-readable status (one JSON object, rebuilt by the report task every second):
 // what the README's "Diagnose" section documents. Keys are stable; units are in the names;
 // a value that is not known yet is null.
-#include <nlohmann/json.hpp>
-
 #include <cmath>
 #include <limits>
+#include <nlohmann/json.hpp>
 
 #include "firmware/daemon.hpp"
 

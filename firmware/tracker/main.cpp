@@ -19,9 +19,9 @@
 #include <numbers>
 #include <string>
 
-#include "amfitrack/tap_link.hpp"
 #include "amfitrack/amfitrack.hpp"
 #include "amfitrack/open_link.hpp"
+#include "amfitrack/tap_link.hpp"
 #include "firmware/tool_console.hpp"
 #include "hal/capture/packet_log.hpp"
 #include "hal/linux_clock.hpp"

@@ -3,9 +3,9 @@
 // packets ray cast from the world), the supervisor gating every command.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <algorithm>
 #include <numeric>
 
 #include "firmware/config/config_loader.hpp"
@@ -36,8 +36,8 @@ void print(const std::string& name, const sim::SimRunResult& r) {
       name.c_str(), m.success ? "SUCCESS" : "FAIL", m.failure.c_str(), m.uncomfortable_s,
       m.inside_ellipse_s, m.active_s, m.duration_s, m.rmse_ex_m, m.rmse_ey_m, m.rmse_etheta_rad,
       m.min_static_clearance_m, m.min_people_clearance_m, m.min_person_distance_m,
-      m.max_person_distance_m, m.mean_person_distance_m,
-      static_cast<unsigned long long>(m.stops), r.wall_s);
+      m.max_person_distance_m, m.mean_person_distance_m, static_cast<unsigned long long>(m.stops),
+      r.wall_s);
 }
 
 bool is_active(const firmware::Daemon& d) {
@@ -135,11 +135,14 @@ TEST(ClosedLoop, LowTrackerConfidenceStopsWithinTheBoundAndResumesAfterTheHyster
   const auto cfg = defaults();
   ASSERT_GT(stopped_at, 0) << "stopped";
   // The gate needs the frames, the supervisor one tick, the stop at most stop_max_time_ms.
-  EXPECT_LE(stopped_at - drop_at, static_cast<double>(cfg.supervisor.stop_max_time_ms) / 1000.0 + 0.1);
+  EXPECT_LE(stopped_at - drop_at,
+            static_cast<double>(cfg.supervisor.stop_max_time_ms) / 1000.0 + 0.1);
   ASSERT_GT(resumed_at, 0) << "resumed; " << final_status;
-  EXPECT_GE(resumed_at - good_again, static_cast<double>(cfg.supervisor.tracker_confidence_recover_ms) / 1000.0)
+  EXPECT_GE(resumed_at - good_again,
+            static_cast<double>(cfg.supervisor.tracker_confidence_recover_ms) / 1000.0)
       << "not before the hysteresis";
-  EXPECT_LE(resumed_at - good_again, static_cast<double>(cfg.supervisor.tracker_confidence_recover_ms) / 1000.0 + 0.5);
+  EXPECT_LE(resumed_at - good_again,
+            static_cast<double>(cfg.supervisor.tracker_confidence_recover_ms) / 1000.0 + 0.5);
   EXPECT_FALSE(r.metrics.collision);
 }
 
@@ -218,11 +221,13 @@ TEST(ClosedLoop, ShutdownCommandsZeroAndTheBaseConfirmsStandstill) {
   o.capture_can = true;
   const auto r = sim::run_simulation(o);
   ASSERT_TRUE(complete);
-  EXPECT_LE(complete_at - 7.0, static_cast<double>(defaults().supervisor.stop_max_time_ms) / 1000.0 + 0.2);
+  EXPECT_LE(complete_at - 7.0,
+            static_cast<double>(defaults().supervisor.stop_max_time_ms) / 1000.0 + 0.2);
   // The last motion command on the bus is zero.
   for (auto it = r.can_out.rbegin(); it != r.can_out.rend(); ++it) {
     if (it->id == scout_mini::id::kMotionCommand) {
-      EXPECT_TRUE(std::all_of(it->data.begin(), it->data.begin() + 6, [](uint8_t b) { return b == 0; }));
+      EXPECT_TRUE(
+          std::all_of(it->data.begin(), it->data.begin() + 6, [](uint8_t b) { return b == 0; }));
       break;
     }
   }
@@ -245,8 +250,8 @@ TEST(ClosedLoop, SameSeedSameCanOutputBitForBit) {
 // ---- recorded pedestrians (scenario 11) ---------------------------------------------------------
 
 TEST(ClosedLoop, FollowsARecordedPersonThroughARecordedCrowd) {
-  const auto loaded = sim::load_pedestrian_dataset(
-      std::string(COMPANION_PEDESTRIANS) + "/crowds_zara01.txt", 0.4);
+  const auto loaded =
+      sim::load_pedestrian_dataset(std::string(COMPANION_PEDESTRIANS) + "/crowds_zara01.txt", 0.4);
   ASSERT_TRUE(loaded.ok) << loaded.error;
   std::string error;
   const auto s = sim::recorded_scenario(loaded.data, sim::longest_walk(loaded.data), &error);

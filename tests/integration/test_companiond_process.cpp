@@ -170,9 +170,8 @@ TEST(CompanionSim, RealTimeRunAccompaniesThenSigtermStopsTheBaseAndWritesTheRepo
   ASSERT_TRUE(sock.ok());
   sock.export_env();
   const std::string dir = ::testing::TempDir() + "companion-sim-rt";
-  ChildProcess p({COMPANIOND_PATH, "--config", COMPANION_SIM_CONFIG, "--scenario", "open",
-                  "--live", "--log-sink", "console", "--status-file", dir + "-status.json",
-                  "--report", dir});
+  ChildProcess p({COMPANIOND_PATH, "--config", COMPANION_SIM_CONFIG, "--scenario", "open", "--live",
+                  "--log-sink", "console", "--status-file", dir + "-status.json", "--report", dir});
   unsetenv("NOTIFY_SOCKET");
   ASSERT_TRUE(p.started());
   ASSERT_TRUE(sock.receive_containing("READY=1", 10s).has_value()) << p.output();

@@ -223,12 +223,13 @@ MppiOutput Mppi::step(const MppiInputs& in) {
   // Per-step preparation shared by all samples.
   goal_frames_.clear();
   if (in.goal_path.empty()) {
-    goal_frames_.push_back({in.goal.x_m, in.goal.y_m, in.goal.theta_rad, std::cos(in.goal.theta_rad),
-                            std::sin(in.goal.theta_rad)});
+    goal_frames_.push_back({in.goal.x_m, in.goal.y_m, in.goal.theta_rad,
+                            std::cos(in.goal.theta_rad), std::sin(in.goal.theta_rad)});
   }
   for (size_t k = 0; k < in.goal_path.size() && k < goal_frames_.capacity(); ++k) {
     const Pose2& g = in.goal_path[k];
-    goal_frames_.push_back({g.x_m, g.y_m, g.theta_rad, std::cos(g.theta_rad), std::sin(g.theta_rad)});
+    goal_frames_.push_back(
+        {g.x_m, g.y_m, g.theta_rad, std::cos(g.theta_rad), std::sin(g.theta_rad)});
   }
   robot_cos_ = std::cos(in.robot.theta_rad);
   robot_sin_ = std::sin(in.robot.theta_rad);
@@ -269,8 +270,8 @@ MppiOutput Mppi::step(const MppiInputs& in) {
   };
   double lambda = cfg_.lambda;
   double ess = weigh(lambda);
-  const auto want = static_cast<double>(std::min<size_t>(
-      static_cast<size_t>(std::max(cfg_.min_effective_samples, 0)), cost_.size()));
+  const auto want = static_cast<double>(
+      std::min<size_t>(static_cast<size_t>(std::max(cfg_.min_effective_samples, 0)), cost_.size()));
   if (ess < want) {
     double lo = lambda;
     double hi = lambda;

@@ -106,9 +106,9 @@ struct ControlStatus {
   bool repaired = false;           // the QP repair changed the first control
   double min_cost = 0;             // the best rollout's cost
   double effective_samples = 0;
-  uint64_t runs = 0;       // MPPI steps so far
-  uint64_t failures = 0;   // MPPI steps that failed
-  uint64_t repairs = 0;    // first controls the QP repair changed
+  uint64_t runs = 0;           // MPPI steps so far
+  uint64_t failures = 0;       // MPPI steps that failed
+  uint64_t repairs = 0;        // first controls the QP repair changed
   core::BodyVelocity command;  // after the supervisor's gate (what went to the base)
 };
 

@@ -41,8 +41,7 @@ std::optional<StampedCanFrame> RecordingCanBus::receive() {
 }
 
 RecordingDatagramSource::RecordingDatagramSource(std::unique_ptr<DatagramSource> inner,
-                                                 std::unique_ptr<PcapWriter> out,
-                                                 uint16_t to_port)
+                                                 std::unique_ptr<PcapWriter> out, uint16_t to_port)
     : inner_(std::move(inner)), out_(std::move(out)), to_port_(to_port) {}
 
 size_t RecordingDatagramSource::drain(size_t max_datagrams, Nanos now,

@@ -18,9 +18,9 @@ int sector_of(double angle_rad) {
 }
 
 const char* sector_name(int sector) {
-  static constexpr std::array<const char*, 8> kNames = {
-      "front", "front-left", "left", "behind-left", "behind", "behind-right", "right",
-      "front-right"};
+  static constexpr std::array<const char*, 8> kNames = {"front",       "front-left", "left",
+                                                        "behind-left", "behind",     "behind-right",
+                                                        "right",       "front-right"};
   return sector >= 0 && sector < 8 ? kNames[static_cast<size_t>(sector)] : "-";
 }
 

@@ -2,13 +2,12 @@
 
 #include <fmt/format.h>
 
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <nlohmann/json.hpp>
 
 namespace sim {
 
@@ -83,12 +82,12 @@ std::string trajectory_svg(const RunReportInputs& in) {
       w, h + 70, w, h + 70);
   // 1 m grid.
   for (double x = std::ceil(b.x0); x <= b.x1; x += 1.0) {
-    svg += fmt::format("<line x1=\"{0:.1f}\" y1=\"0\" x2=\"{0:.1f}\" y2=\"{1:.1f}\" stroke=\"#eee\"/>\n",
-                       X(x), h);
+    svg += fmt::format(
+        "<line x1=\"{0:.1f}\" y1=\"0\" x2=\"{0:.1f}\" y2=\"{1:.1f}\" stroke=\"#eee\"/>\n", X(x), h);
   }
   for (double y = std::ceil(b.y0); y <= b.y1; y += 1.0) {
-    svg += fmt::format("<line x1=\"0\" y1=\"{0:.1f}\" x2=\"{1:.1f}\" y2=\"{0:.1f}\" stroke=\"#eee\"/>\n",
-                       Y(y), w);
+    svg += fmt::format(
+        "<line x1=\"0\" y1=\"{0:.1f}\" x2=\"{1:.1f}\" y2=\"{0:.1f}\" stroke=\"#eee\"/>\n", Y(y), w);
   }
   for (const Segment& s : sc.world.segments) {
     svg += fmt::format(
@@ -142,8 +141,9 @@ std::string trajectory_svg(const RunReportInputs& in) {
         "stroke-width=\"2\"/>\n",
         X(s.robot.x_m), Y(s.robot.y_m), X(s.robot.x_m + 0.4 * std::cos(s.robot.theta_rad)),
         Y(s.robot.y_m + 0.4 * std::sin(s.robot.theta_rad)));
-    svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" fill=\"#777\" font-size=\"10\">{:.0f}s</text>\n",
-                       X(s.person.x_m) + 4, Y(s.person.y_m) - 4, s.t_s);
+    svg += fmt::format(
+        "<text x=\"{:.1f}\" y=\"{:.1f}\" fill=\"#777\" font-size=\"10\">{:.0f}s</text>\n",
+        X(s.person.x_m) + 4, Y(s.person.y_m) - 4, s.t_s);
   }
   // Legend and title.
   const double ly = h + 20;
@@ -169,8 +169,8 @@ std::string report_markdown(const RunReportInputs& in) {
   md += fmt::format("| collision | {} |\n", m.collision ? "yes" : "no");
   md += fmt::format("| UT (robot < 0.45 m from the person) | {:.2f} s |\n", m.uncomfortable_s);
   md += fmt::format("| time inside the CBF ellipse (h < 0) | {:.2f} s |\n", m.inside_ellipse_s);
-  md += fmt::format("| RMSE e_x / e_y / e_theta | {:.3f} m / {:.3f} m / {:.3f} rad |\n", m.rmse_ex_m,
-                    m.rmse_ey_m, m.rmse_etheta_rad);
+  md += fmt::format("| RMSE e_x / e_y / e_theta | {:.3f} m / {:.3f} m / {:.3f} rad |\n",
+                    m.rmse_ex_m, m.rmse_ey_m, m.rmse_etheta_rad);
   md += fmt::format("| person distance min / mean / max (moving) | {:.2f} / {:.2f} / {:.2f} m |\n",
                     m.min_person_distance_m, m.mean_person_distance_m, m.max_person_distance_m);
   md += fmt::format("| longest stretch > 2 m from the person | {:.1f} s |\n", m.longest_far_s);
@@ -179,8 +179,8 @@ std::string report_markdown(const RunReportInputs& in) {
                     clearance(m.min_static_clearance_m), clearance(m.min_people_clearance_m));
   md += fmt::format("| RMS jerk of the command | {:.1f} m/s^3 |\n", m.rms_jerk);
   if (!in.policy_ms.empty()) {
-    md += fmt::format("| policy step p50 / p99 | {:.3f} / {:.3f} ms |\n", quantile(in.policy_ms, 0.5),
-                      quantile(in.policy_ms, 0.99));
+    md += fmt::format("| policy step p50 / p99 | {:.3f} / {:.3f} ms |\n",
+                      quantile(in.policy_ms, 0.5), quantile(in.policy_ms, 0.99));
   }
   if (!in.control_ms.empty()) {
     md += fmt::format("| control step (MPPI-CBF + repair) p50 / p99 | {:.3f} / {:.3f} ms |\n",
@@ -190,7 +190,8 @@ std::string report_markdown(const RunReportInputs& in) {
   double total = 0;
   for (double t : m.side_time_s)
     total += t;
-  md += "| front | front-left | left | behind-left | behind | behind-right | right | front-right |\n";
+  md +=
+      "| front | front-left | left | behind-left | behind | behind-right | right | front-right |\n";
   md += "|---|---|---|---|---|---|---|---|\n|";
   for (double t : m.side_time_s)
     md += fmt::format(" {:.0f} % |", total > 0 ? 100.0 * t / total : 0.0);
@@ -205,32 +206,31 @@ std::string metrics_json(const RunReportInputs& in) {
     return v.empty() ? nlohmann::json(nullptr) : nlohmann::json(quantile(v, p));
   };
   auto clearance = [](double v) { return v > 1e6 ? nlohmann::json(nullptr) : nlohmann::json(v); };
-  const nlohmann::json j = {
-      {"scenario", in.scenario->name},
-      {"success", m.success},
-      {"failure", m.failure},
-      {"collision", m.collision},
-      {"duration_s", m.duration_s},
-      {"active_s", m.active_s},
-      {"tracking_s", m.tracking_s},
-      {"uncomfortable_s", m.uncomfortable_s},
-      {"inside_ellipse_s", m.inside_ellipse_s},
-      {"rmse_ex_m", m.rmse_ex_m},
-      {"rmse_ey_m", m.rmse_ey_m},
-      {"rmse_etheta_rad", m.rmse_etheta_rad},
-      {"min_person_distance_m", m.min_person_distance_m},
-      {"mean_person_distance_m", m.mean_person_distance_m},
-      {"max_person_distance_m", m.max_person_distance_m},
-      {"longest_far_s", m.longest_far_s},
-      {"min_static_clearance_m", clearance(m.min_static_clearance_m)},
-      {"min_people_clearance_m", clearance(m.min_people_clearance_m)},
-      {"rms_jerk_mps3", m.rms_jerk},
-      {"stops", m.stops},
-      {"side_time_s", m.side_time_s},
-      {"policy_ms_p50", q(in.policy_ms, 0.5)},
-      {"policy_ms_p99", q(in.policy_ms, 0.99)},
-      {"control_ms_p50", q(in.control_ms, 0.5)},
-      {"control_ms_p99", q(in.control_ms, 0.99)}};
+  const nlohmann::json j = {{"scenario", in.scenario->name},
+                            {"success", m.success},
+                            {"failure", m.failure},
+                            {"collision", m.collision},
+                            {"duration_s", m.duration_s},
+                            {"active_s", m.active_s},
+                            {"tracking_s", m.tracking_s},
+                            {"uncomfortable_s", m.uncomfortable_s},
+                            {"inside_ellipse_s", m.inside_ellipse_s},
+                            {"rmse_ex_m", m.rmse_ex_m},
+                            {"rmse_ey_m", m.rmse_ey_m},
+                            {"rmse_etheta_rad", m.rmse_etheta_rad},
+                            {"min_person_distance_m", m.min_person_distance_m},
+                            {"mean_person_distance_m", m.mean_person_distance_m},
+                            {"max_person_distance_m", m.max_person_distance_m},
+                            {"longest_far_s", m.longest_far_s},
+                            {"min_static_clearance_m", clearance(m.min_static_clearance_m)},
+                            {"min_people_clearance_m", clearance(m.min_people_clearance_m)},
+                            {"rms_jerk_mps3", m.rms_jerk},
+                            {"stops", m.stops},
+                            {"side_time_s", m.side_time_s},
+                            {"policy_ms_p50", q(in.policy_ms, 0.5)},
+                            {"policy_ms_p99", q(in.policy_ms, 0.99)},
+                            {"control_ms_p50", q(in.control_ms, 0.5)},
+                            {"control_ms_p99", q(in.control_ms, 0.99)}};
   return j.dump(2) + "\n";
 }
 
@@ -239,10 +239,10 @@ std::string samples_csv(const std::vector<RunSample>& samples) {
       "t_s,robot_x_m,robot_y_m,robot_theta_rad,person_x_m,person_y_m,person_theta_rad,active,"
       "has_goal,goal_x_m,goal_y_m,side,pedestrians\n";
   for (const RunSample& s : samples) {
-    out += fmt::format("{:.3f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{},{},{:.4f},{:.4f},{},{}\n",
-                       s.t_s, s.robot.x_m, s.robot.y_m, s.robot.theta_rad, s.person.x_m,
-                       s.person.y_m, s.person.theta_rad, s.active ? 1 : 0, s.has_goal ? 1 : 0,
-                       s.goal.x_m, s.goal.y_m, s.side, s.pedestrians.size());
+    out += fmt::format(
+        "{:.3f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{},{},{:.4f},{:.4f},{},{}\n", s.t_s,
+        s.robot.x_m, s.robot.y_m, s.robot.theta_rad, s.person.x_m, s.person.y_m, s.person.theta_rad,
+        s.active ? 1 : 0, s.has_goal ? 1 : 0, s.goal.x_m, s.goal.y_m, s.side, s.pedestrians.size());
   }
   return out;
 }

@@ -44,8 +44,8 @@ DaemonView daemon_view(const firmware::Daemon& daemon, const core::Pose2& robot_
     v.has_goal = true;
     v.goal_odom = g->value.goal_odom;
     v.goal_world = robot_world * (v.robot_odom.inverse() * v.goal_odom);
-    v.side = g->value.points > 0 ? (8 * g->value.index + g->value.points / 2) / g->value.points % 8
-                                 : -1;
+    v.side =
+        g->value.points > 0 ? (8 * g->value.index + g->value.points / 2) / g->value.points % 8 : -1;
   }
   if (const auto c = daemon.command().read()) {
     v.cmd_vx = c->value.vx_mps;
@@ -72,8 +72,8 @@ SimRunResult run_simulation(const SimRunOptions& o) {
   daemon.attach_lidar(world.take_lidar_source());
   std::unique_ptr<hal::VirtualCanBus> sniffer = world.open_can_sniffer();
 
-  RunMetricsRecorder recorder(MetricsConfig{cfg.interactive_space.ellipse_a_m,
-                                            cfg.interactive_space.ellipse_b_m});
+  RunMetricsRecorder recorder(
+      MetricsConfig{cfg.interactive_space.ellipse_a_m, cfg.interactive_space.ellipse_b_m});
   auto tasks = daemon.bindings();
   for (auto& t : tasks) {
     // Wall time of the planning tasks (the simulated clock does not advance inside a task).
@@ -95,11 +95,10 @@ SimRunResult run_simulation(const SimRunOptions& o) {
                      if (o.script) o.script(t_s, world, daemon);
                      world.step(tick.now);
                      const core::Pose2 robot = world.robot_pose();
-                     recorder.record(t_s, step_s, robot, world.person_pose(),
-                                     world.pedestrian_positions(),
-                                     world.footprint_clearance_static(),
-                                     world.footprint_clearance_people(),
-                                     daemon_view(daemon, robot));
+                     recorder.record(
+                         t_s, step_s, robot, world.person_pose(), world.pedestrian_positions(),
+                         world.footprint_clearance_static(), world.footprint_clearance_people(),
+                         daemon_view(daemon, robot));
                      while (auto f = sniffer->receive()) {
                        if (o.capture_can) result.can_out.push_back(f->frame);
                      }

@@ -56,14 +56,14 @@ DatasetLoad parse_pedestrian_dataset(const std::string& text, double frame_perio
     double v[4];
     for (size_t i = 0; i < 4; ++i) {
       if (!parse_double(tok[i], v[i])) {
-        r.error = fmt::format("{}:{}: column {} is not a number: '{}'", name, line_no, i + 1,
-                              tok[i]);
+        r.error =
+            fmt::format("{}:{}: column {} is not a number: '{}'", name, line_no, i + 1, tok[i]);
         return r;
       }
     }
     if (v[1] != std::floor(v[1]) || std::abs(v[1]) > 1e9) {
-      r.error = fmt::format("{}:{}: person id must be a whole number, got '{}'", name, line_no,
-                            tok[1]);
+      r.error =
+          fmt::format("{}:{}: person id must be a whole number, got '{}'", name, line_no, tok[1]);
       return r;
     }
     rows.push_back({v[0], v[2], v[3], static_cast<int>(v[1])});
@@ -86,8 +86,8 @@ DatasetLoad parse_pedestrian_dataset(const std::string& text, double frame_perio
   for (const Row& row : rows) {
     const double t = (row.frame - first) / step * frame_period_s;
     if (!std::isfinite(t) || t > kMaxDurationS) {
-      r.error = fmt::format("{}: frame {} is {} s after the first: not a recording", name,
-                            row.frame, t);
+      r.error =
+          fmt::format("{}: frame {} is {} s after the first: not a recording", name, row.frame, t);
       return r;
     }
     by_id[row.id].push_back({t, {row.x, row.y, 0.0}});
@@ -96,9 +96,10 @@ DatasetLoad parse_pedestrian_dataset(const std::string& text, double frame_perio
     std::stable_sort(samples.begin(), samples.end(),
                      [](const TimedPose& a, const TimedPose& b) { return a.t_s < b.t_s; });
     // One observation per frame: a repeated frame of the same person keeps the first.
-    samples.erase(std::unique(samples.begin(), samples.end(),
-                              [](const TimedPose& a, const TimedPose& b) { return a.t_s == b.t_s; }),
-                  samples.end());
+    samples.erase(
+        std::unique(samples.begin(), samples.end(),
+                    [](const TimedPose& a, const TimedPose& b) { return a.t_s == b.t_s; }),
+        samples.end());
     set_headings_from_motion(samples);
     r.data.people.emplace(id, Trajectory(std::move(samples)));
   }

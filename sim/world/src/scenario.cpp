@@ -51,15 +51,16 @@ Scenario static_obstacle() {
 }
 
 Scenario pedestrian_front_right() {
-  Scenario s = base_scenario("pedestrian_front_right", "a pedestrian approaching from the front-right",
-                             {{{0, 0}}, {{16, 0}, 1.0}});
+  Scenario s =
+      base_scenario("pedestrian_front_right", "a pedestrian approaching from the front-right",
+                    {{{0, 0}}, {{16, 0}, 1.0}});
   s.pedestrians.push_back(walker({16.0, -3.0}, {-4.0, 1.0}, 1.2));
   return s;
 }
 
 Scenario corridor() {
-  Scenario s = base_scenario("corridor", "a corridor narrowing on both sides",
-                             {{{0, 0}}, {{18, 0}, 1.0}});
+  Scenario s =
+      base_scenario("corridor", "a corridor narrowing on both sides", {{{0, 0}}, {{18, 0}, 1.0}});
   // 5 m wide, narrowing to 2.4 m between x = 7 and 12, then wide again.
   for (double side : {-1.0, 1.0}) {
     s.world.add_wall({-3.0, 2.5 * side}, {5.0, 2.5 * side});

@@ -1,7 +1,6 @@
 #include "sim/sim_world.hpp"
 
 #include <Eigen/Geometry>
-
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -171,11 +170,11 @@ void SimWorld::step(hal::Nanos now) {
       const auto q = r.pose_at(t_s_);
       cylinders_.push_back({{q.x_m, q.y_m}, kReplayedRadiusM, 1.75});
     }
-    lidar_.step(last_step_, scenario_.world, cylinders_,
-                [this](hal::Nanos t) { return robot_at(t); },
-                [this](std::span<const uint8_t> bytes, hal::Nanos arrival) {
-                  if (!lidar_silent_) lidar_queue_->push(bytes, arrival);
-                });
+    lidar_.step(
+        last_step_, scenario_.world, cylinders_, [this](hal::Nanos t) { return robot_at(t); },
+        [this](std::span<const uint8_t> bytes, hal::Nanos arrival) {
+          if (!lidar_silent_) lidar_queue_->push(bytes, arrival);
+        });
   }
 }
 
@@ -205,8 +204,10 @@ double SimWorld::footprint_clearance_static() const {
         if (q < 0) inside = false;
       } else {
         const double r = q / p;
-        if (p < 0) t0 = std::max(t0, r);
-        else t1 = std::min(t1, r);
+        if (p < 0)
+          t0 = std::max(t0, r);
+        else
+          t1 = std::min(t1, r);
       }
     }
     if (inside && t0 <= t1) return 0.0;

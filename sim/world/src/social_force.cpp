@@ -23,8 +23,8 @@ Point2 Crowd::person_force(const Point2& self, const Point2& desired_dir,
                            const MovingBody& other) const {
   const double speed = norm(other.velocity);
   const double s = speed * params_.step_width_s;
-  const Point2 e = speed > 1e-9 ? Point2{other.velocity.x_m / speed, other.velocity.y_m / speed}
-                                : Point2{0, 0};
+  const Point2 e =
+      speed > 1e-9 ? Point2{other.velocity.x_m / speed, other.velocity.y_m / speed} : Point2{0, 0};
   // V(r) = V0 exp(-b(r) / sigma), 2b = sqrt((|r| + |r - s e|)^2 - s^2), r = self - other; the
   // force is -grad V, taken by central differences.
   auto potential = [&](double rx, double ry) {
@@ -51,7 +51,8 @@ Point2 Crowd::wall_force(const Point2& self, const Point2& desired_dir,
     const double dy = self.y_m - nearest.y_m;
     const double d = std::hypot(dx, dy);
     if (d_surface > params_.interaction_range_m || d < 1e-9) return;
-    const double mag = params_.u0_m2ps2 / params_.wall_r_m * std::exp(-d_surface / params_.wall_r_m);
+    const double mag =
+        params_.u0_m2ps2 / params_.wall_r_m * std::exp(-d_surface / params_.wall_r_m);
     Point2 f{mag * dx / d, mag * dy / d};
     const double w = fov_weight(desired_dir, f);
     total.x_m += w * f.x_m;
@@ -65,7 +66,8 @@ Point2 Crowd::wall_force(const Point2& self, const Point2& desired_dir,
     const double r = std::hypot(self.x_m - c.center.x_m, self.y_m - c.center.y_m);
     if (r < 1e-9) continue;
     const double k = c.radius_m / r;
-    add({c.center.x_m + (self.x_m - c.center.x_m) * k, c.center.y_m + (self.y_m - c.center.y_m) * k},
+    add({c.center.x_m + (self.x_m - c.center.x_m) * k,
+         c.center.y_m + (self.y_m - c.center.y_m) * k},
         std::max(r - c.radius_m, 0.0));
   }
   return total;

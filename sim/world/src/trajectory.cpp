@@ -90,7 +90,8 @@ Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s, double s
   }
   size_t k = 0;
   for (double s = 0; s <= t + 1e-9; s += step_s) {
-    while (k + 1 < knots.size() && knots[k + 1].t < s) ++k;
+    while (k + 1 < knots.size() && knots[k + 1].t < s)
+      ++k;
     core::Point2 p = knots[k].p;
     if (k + 1 < knots.size()) {
       const double span = knots[k + 1].t - knots[k].t;

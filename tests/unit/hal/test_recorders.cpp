@@ -52,8 +52,8 @@ TEST(RecordingCanBus, TheLogReadsBackWithWallClockTimes) {
   hal::SimClock clock(5s);
   const std::string path = ::testing::TempDir() + "rec2.candump";
   {
-    hal::RecordingCanBus bus(std::make_unique<hal::VirtualCanBus>("rec-test2", clock), path,
-                             "can0", clock);
+    hal::RecordingCanBus bus(std::make_unique<hal::VirtualCanBus>("rec-test2", clock), path, "can0",
+                             clock);
     hal::CanFrame f;
     f.id = 0x421;
     f.dlc = 1;

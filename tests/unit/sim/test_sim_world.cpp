@@ -133,8 +133,7 @@ TEST(PedestrianDataset, BadInputIsAClearErrorWithTheLine) {
 
 TEST(PedestrianDataset, LoadsTheShippedRecordings) {
   for (const char* f : {"biwi_hotel.txt", "crowds_zara01.txt"}) {
-    const auto r =
-        sim::load_pedestrian_dataset(std::string(COMPANION_PEDESTRIANS) + "/" + f, 0.4);
+    const auto r = sim::load_pedestrian_dataset(std::string(COMPANION_PEDESTRIANS) + "/" + f, 0.4);
     ASSERT_TRUE(r.ok) << r.error;
     EXPECT_GT(r.data.people.size(), 100U) << f;
     EXPECT_EQ(r.data.frame_step, 10.0) << f;
@@ -254,8 +253,8 @@ TEST(SimVlp16, AWallAheadDecodesAtItsDistanceAndTheGroundBelowTheSensor) {
     }
   };
   for (int ms = 5; ms <= 200; ms += 5)
-    lidar.step(hal::Nanos(std::chrono::milliseconds(ms)), w, {}, [](hal::Nanos) { return Pose2{}; },
-               sink);
+    lidar.step(
+        hal::Nanos(std::chrono::milliseconds(ms)), w, {}, [](hal::Nanos) { return Pose2{}; }, sink);
   EXPECT_GT(wall, 100);
   EXPECT_GT(ground, 100);
   EXPECT_GT(behind, 0) << "only ground behind";
@@ -284,8 +283,9 @@ TEST(SimVlp16, PeopleAreCylindersThatLowBeamsHitAndHighBeamsPass) {
     }
   };
   for (int ms = 5; ms <= 100; ms += 5)
-    lidar.step(hal::Nanos(std::chrono::milliseconds(ms)), empty, person,
-               [](hal::Nanos) { return Pose2{}; }, sink);
+    lidar.step(
+        hal::Nanos(std::chrono::milliseconds(ms)), empty, person,
+        [](hal::Nanos) { return Pose2{}; }, sink);
   EXPECT_GT(hits, 20);
   EXPECT_LE(max_z, 1.0 - 0.45 + 0.01) << "nothing above the person's head";
 }
@@ -343,7 +343,8 @@ TEST(DatagramQueue, DeliversWhatHasArrivedByNowAndCountsOverflow) {
   EXPECT_EQ(seen, (std::vector<int64_t>{10, 20})) << "not the one arriving at 30";
   EXPECT_EQ(q.stats().kernel_drops, 1U);
   EXPECT_EQ(q.stats().datagrams, 2U);
-  q.drain(100, hal::Nanos(100), [&](const hal::UdpDatagram& d) { seen.push_back(d.stamp.count()); });
+  q.drain(100, hal::Nanos(100),
+          [&](const hal::UdpDatagram& d) { seen.push_back(d.stamp.count()); });
   EXPECT_EQ(seen.size(), 3U);
 }
 

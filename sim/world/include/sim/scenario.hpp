@@ -17,9 +17,9 @@ struct Scenario {
   std::string name;
   std::string description;
   StaticWorld world;
-  Trajectory person;          // the followed person (world frame)
+  Trajectory person;  // the followed person (world frame)
   double person_radius_m = 0.25;
-  core::Pose2 robot_start;    // world frame
+  core::Pose2 robot_start;  // world frame
   std::vector<Pedestrian> pedestrians;
   std::vector<Trajectory> replayed;  // recorded people: move as recorded, avoid no one
   double duration_s = 60.0;

@@ -87,8 +87,8 @@ class SimWorld {
   SimWorldConfig config_;
   hal::Clock& clock_;
   std::string can_network_;
-  std::unique_ptr<hal::VirtualCanBus> base_bus_;       // the base's end
-  std::unique_ptr<hal::VirtualCanBus> daemon_bus_;     // until taken
+  std::unique_ptr<hal::VirtualCanBus> base_bus_;    // the base's end
+  std::unique_ptr<hal::VirtualCanBus> daemon_bus_;  // until taken
   std::unique_ptr<SimScoutMini> base_;
   SimAmfitrack tracker_;
   SimVlp16 lidar_;
@@ -106,8 +106,8 @@ class SimWorld {
   hal::Nanos prev_robot_time_{0};
   core::Pose2 person_;
   Point2 person_velocity_;
-  std::vector<Cylinder> cylinders_;     // scratch
-  std::vector<MovingBody> bodies_;      // scratch
+  std::vector<Cylinder> cylinders_;  // scratch
+  std::vector<MovingBody> bodies_;   // scratch
 };
 
 }  // namespace sim

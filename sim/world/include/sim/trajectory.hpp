@@ -38,8 +38,7 @@ struct Waypoint {
   double pause_s = 0;      // standing here before the next leg
 };
 // Sampled every `step_s`, starting at `start_s` (standing at the first waypoint until then).
-Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s = 0.0,
-                double step_s = 0.05);
+Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s = 0.0, double step_s = 0.05);
 
 // Headings of position samples from their motion (kept while standing: below 0.2 m/s).
 // Path length walked (m).
