@@ -7,8 +7,8 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <limits>
+#include <system_error>
 
 #include "firmware/task_table.hpp"
 
@@ -761,8 +761,9 @@ void Daemon::write_status_file() {
   if (f != nullptr) ok = std::fclose(f) == 0 && ok;
   if (ok) ok = std::rename(tmp.c_str(), status_file_.c_str()) == 0;
   if (!ok && !status_file_warned_) {
-    spdlog::warn("status: cannot write {}: {} (not retried in the log)", status_file_,
-                 std::strerror(errno));
+    // std::error_code's message is thread-safe (strerror is not).
+    spdlog::warn("status: cannot write {}: {} (not repeated in the log)", status_file_,
+                 std::error_code(errno, std::generic_category()).message());
     status_file_warned_ = true;
   }
 }

@@ -73,37 +73,41 @@ std::string trajectory_svg(const RunReportInputs& in) {
   const double scale = 900.0 / std::max(b.x1 - b.x0, b.y1 - b.y0);  // px per m
   const double w = (b.x1 - b.x0) * scale;
   const double h = (b.y1 - b.y0) * scale;
-  auto X = [&](double x) { return (x - b.x0) * scale; };
-  auto Y = [&](double y) { return (b.y1 - y) * scale; };  // y up
+  auto px = [&](double x) { return (x - b.x0) * scale; };
+  auto py = [&](double y) { return (b.y1 - y) * scale; };  // y up
   std::string svg = fmt::format(
       "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{:.0f}\" height=\"{:.0f}\" "
       "viewBox=\"0 0 {:.0f} {:.0f}\" font-family=\"sans-serif\" font-size=\"13\">\n"
       "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n",
       w, h + 70, w, h + 70);
   // 1 m grid.
-  for (double x = std::ceil(b.x0); x <= b.x1; x += 1.0) {
+  for (int i = static_cast<int>(std::ceil(b.x0)); i <= static_cast<int>(std::floor(b.x1)); ++i) {
+    const double x = i;
     svg += fmt::format(
-        "<line x1=\"{0:.1f}\" y1=\"0\" x2=\"{0:.1f}\" y2=\"{1:.1f}\" stroke=\"#eee\"/>\n", X(x), h);
+        "<line x1=\"{0:.1f}\" y1=\"0\" x2=\"{0:.1f}\" y2=\"{1:.1f}\" stroke=\"#eee\"/>\n", px(x),
+        h);
   }
-  for (double y = std::ceil(b.y0); y <= b.y1; y += 1.0) {
+  for (int i = static_cast<int>(std::ceil(b.y0)); i <= static_cast<int>(std::floor(b.y1)); ++i) {
+    const double y = i;
     svg += fmt::format(
-        "<line x1=\"0\" y1=\"{0:.1f}\" x2=\"{1:.1f}\" y2=\"{0:.1f}\" stroke=\"#eee\"/>\n", Y(y), w);
+        "<line x1=\"0\" y1=\"{0:.1f}\" x2=\"{1:.1f}\" y2=\"{0:.1f}\" stroke=\"#eee\"/>\n", py(y),
+        w);
   }
   for (const Segment& s : sc.world.segments) {
     svg += fmt::format(
         "<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#333\" "
         "stroke-width=\"4\"/>\n",
-        X(s.a.x_m), Y(s.a.y_m), X(s.b.x_m), Y(s.b.y_m));
+        px(s.a.x_m), py(s.a.y_m), px(s.b.x_m), py(s.b.y_m));
   }
   for (const Circle& c : sc.world.circles) {
     svg += fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"{:.1f}\" fill=\"#555\"/>\n",
-                       X(c.center.x_m), Y(c.center.y_m), c.radius_m * scale);
+                       px(c.center.x_m), py(c.center.y_m), c.radius_m * scale);
   }
   // Pedestrians: faint dots every sample.
   std::string peds;
   for (size_t i = 0; i < samples.size(); i += 2) {
     for (const Point2& p : samples[i].pedestrians) {
-      peds += fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"1.6\"/>", X(p.x_m), Y(p.y_m));
+      peds += fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"1.6\"/>", px(p.x_m), py(p.y_m));
     }
   }
   svg += "<g fill=\"#e39b2b\" fill-opacity=\"0.35\">" + peds + "</g>\n";
@@ -112,15 +116,15 @@ std::string trajectory_svg(const RunReportInputs& in) {
   for (size_t i = 0; i < samples.size(); i += 3) {
     const RunSample& s = samples[i];
     if (!s.has_goal || !s.active) continue;
-    goals += fmt::format("M{:.1f} {:.1f}h6M{:.1f} {:.1f}v6 ", X(s.goal.x_m) - 3, Y(s.goal.y_m),
-                         X(s.goal.x_m), Y(s.goal.y_m) - 3);
+    goals += fmt::format("M{:.1f} {:.1f}h6M{:.1f} {:.1f}v6 ", px(s.goal.x_m) - 3, py(s.goal.y_m),
+                         px(s.goal.x_m), py(s.goal.y_m) - 3);
   }
   svg += "<path d=\"" + goals + "\" stroke=\"#2a9d3a\" stroke-width=\"1.2\" fill=\"none\"/>\n";
   auto polyline = [&](auto pick, const char* colour, double width) {
     std::string pts;
     for (const RunSample& s : samples) {
       const core::Pose2 p = pick(s);
-      pts += fmt::format("{:.1f},{:.1f} ", X(p.x_m), Y(p.y_m));
+      pts += fmt::format("{:.1f},{:.1f} ", px(p.x_m), py(p.y_m));
     }
     return fmt::format(
         "<polyline points=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"{}\" "
@@ -135,15 +139,15 @@ std::string trajectory_svg(const RunReportInputs& in) {
     svg += fmt::format(
         "<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#999\" "
         "stroke-dasharray=\"3 3\"/>\n",
-        X(s.robot.x_m), Y(s.robot.y_m), X(s.person.x_m), Y(s.person.y_m));
+        px(s.robot.x_m), py(s.robot.y_m), px(s.person.x_m), py(s.person.y_m));
     svg += fmt::format(
         "<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#c0392b\" "
         "stroke-width=\"2\"/>\n",
-        X(s.robot.x_m), Y(s.robot.y_m), X(s.robot.x_m + 0.4 * std::cos(s.robot.theta_rad)),
-        Y(s.robot.y_m + 0.4 * std::sin(s.robot.theta_rad)));
+        px(s.robot.x_m), py(s.robot.y_m), px(s.robot.x_m + 0.4 * std::cos(s.robot.theta_rad)),
+        py(s.robot.y_m + 0.4 * std::sin(s.robot.theta_rad)));
     svg += fmt::format(
         "<text x=\"{:.1f}\" y=\"{:.1f}\" fill=\"#777\" font-size=\"10\">{:.0f}s</text>\n",
-        X(s.person.x_m) + 4, Y(s.person.y_m) - 4, s.t_s);
+        px(s.person.x_m) + 4, py(s.person.y_m) - 4, s.t_s);
   }
   // Legend and title.
   const double ly = h + 20;

@@ -204,10 +204,11 @@ double SimWorld::footprint_clearance_static() const {
         if (q < 0) inside = false;
       } else {
         const double r = q / p;
-        if (p < 0)
+        if (p < 0) {
           t0 = std::max(t0, r);
-        else
+        } else {
           t1 = std::min(t1, r);
+        }
       }
     }
     if (inside && t0 <= t1) return 0.0;

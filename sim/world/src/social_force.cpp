@@ -36,9 +36,9 @@ Point2 Crowd::person_force(const Point2& self, const Point2& desired_dir,
   };
   const double rx = self.x_m - other.position.x_m;
   const double ry = self.y_m - other.position.y_m;
-  constexpr double h = 1e-4;
-  const Point2 f{-(potential(rx + h, ry) - potential(rx - h, ry)) / (2 * h),
-                 -(potential(rx, ry + h) - potential(rx, ry - h)) / (2 * h)};
+  constexpr double kStep = 1e-4;
+  const Point2 f{-(potential(rx + kStep, ry) - potential(rx - kStep, ry)) / (2 * kStep),
+                 -(potential(rx, ry + kStep) - potential(rx, ry - kStep)) / (2 * kStep)};
   const double w = fov_weight(desired_dir, f);
   return {w * f.x_m, w * f.y_m};
 }

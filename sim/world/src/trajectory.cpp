@@ -89,7 +89,9 @@ Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s, double s
     }
   }
   size_t k = 0;
-  for (double s = 0; s <= t + 1e-9; s += step_s) {
+  const auto steps = static_cast<size_t>(std::floor(t / step_s + 1e-9));
+  for (size_t i = 0; i <= steps; ++i) {
+    const double s = static_cast<double>(i) * step_s;
     while (k + 1 < knots.size() && knots[k + 1].t < s)
       ++k;
     core::Point2 p = knots[k].p;

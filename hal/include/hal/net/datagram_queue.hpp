@@ -25,7 +25,7 @@ class DatagramQueue final : public DatagramSource {
  private:
   struct Item {
     std::vector<uint8_t> bytes;
-    Nanos arrival;
+    Nanos arrival{0};
   };
   size_t capacity_;
   mutable std::mutex mutex_;
