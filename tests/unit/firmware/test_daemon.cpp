@@ -1,9 +1,13 @@
 // companiond's task table and daemon on the simulated clock, with a real NOTIFY_SOCKET.
 #include <gtest/gtest.h>
 #include <spdlog/sinks/ringbuffer_sink.h>
+
+#include <nlohmann/json.hpp>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdio>
+#include <fstream>
 #include <atomic>
 #include <cmath>
 #include <functional>
@@ -611,4 +615,49 @@ TEST(DaemonWithTrackerAndLidar, ALoadedPolicyChoosesAmongTheFreePoints) {
   EXPECT_EQ(g->value.index, 40);
   EXPECT_NE(d.daemon.status_line().find("| goal policy behind-right"), std::string::npos)
       << d.daemon.status_line();
+}
+
+// The machine-readable status: one JSON object with stable keys, written atomically each second.
+TEST(Daemon, WritesTheStatusFileAsJsonWithTheDocumentedKeys) {
+  const std::string path = ::testing::TempDir() + "companion-status.json";
+  std::remove(path.c_str());
+  SimDaemon d(defaults());
+  d.daemon.set_status_file(path);
+  d.run_until(2500ms);
+  std::ifstream f(path);
+  ASSERT_TRUE(f) << "written";
+  const auto j = nlohmann::json::parse(f);
+  EXPECT_EQ(j["safety"]["state"], "HOLD");
+  EXPECT_EQ(j["safety"]["reason"], "tracker_silent");
+  EXPECT_EQ(j["safety"]["reason_code"], 11);
+  EXPECT_FALSE(j["safety"]["motion_allowed"].get<bool>());
+  ASSERT_EQ(j["tasks"].size(), firmware::task_table().size());
+  for (const auto& t : j["tasks"]) {
+    if (t["name"] == "control") {
+      EXPECT_DOUBLE_EQ(t["rate_hz"].get<double>(), 100.0);
+      EXPECT_EQ(t["nominal_hz"], 100);
+      EXPECT_EQ(t["overruns"], 0);
+    }
+  }
+  EXPECT_EQ(j["control"]["tracking"], false) << "holding: nothing tracked";
+  EXPECT_TRUE(j["goal"]["x_base_m"].is_number());
+  EXPECT_EQ(d.daemon.status_json(), nlohmann::json::parse(d.daemon.status_json()).dump() + "\n");
+}
+
+TEST(Daemon, AnUnwritableStatusFileIsWarnedOnceAndTheDaemonRunsOn) {
+  auto ring = std::make_shared<spdlog::sinks::ringbuffer_sink_mt>(1000);
+  auto previous = spdlog::default_logger();
+  spdlog::set_default_logger(std::make_shared<spdlog::logger>("capture", ring));
+  SimDaemon d(defaults());
+  d.daemon.set_status_file("/nonexistent-dir/status.json");
+  d.run_until(3500ms);
+  spdlog::set_default_logger(previous);
+  int warnings = 0;
+  for (const auto& line : ring->last_formatted()) {
+    if (line.find("status: cannot write /nonexistent-dir/status.json") != std::string::npos) {
+      ++warnings;
+    }
+  }
+  EXPECT_EQ(warnings, 1);
+  EXPECT_EQ(d.daemon.command().read()->count, 351U) << "the control task kept running";
 }
