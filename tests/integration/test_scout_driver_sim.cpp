@@ -248,3 +248,59 @@ TEST(ScoutDriverSim, ProtocolV1IsReportedNotDriven) {
   driver.poll(clock.now());
   EXPECT_EQ(driver.counters().mode_requests, 0U) << "a V1 base is not talked to in V2";
 }
+
+// The simulated base's realism knobs: command latency and velocity-feedback noise.
+TEST(SimScoutMini, CommandsTakeEffectAfterTheLatencyAndFeedbackIsNoisyOnlyWhileMoving) {
+  hal::SimClock clock{1s};
+  hal::VirtualCanBus host("latency", clock);
+  hal::VirtualCanBus base_end("latency", clock);
+  sim::SimScoutConfig cfg;
+  cfg.command_latency = 40ms;
+  cfg.feedback_noise_rel = 0.05;
+  sim::SimScoutMini base(base_end, cfg);
+  std::vector<double> reported;
+  auto step = [&](hal::Nanos d, bool drive) {
+    const hal::Nanos end = clock.now() + d;
+    while (clock.now() < end) {
+      base.step(clock.now());
+      while (auto f = host.receive()) {
+        const auto m = scout_mini::decode(f->frame);
+        if (!m.message) continue;
+        if (const auto* v = std::get_if<scout_mini::MotionState>(&*m.message)) {
+          reported.push_back(v->vx_mps);
+        }
+      }
+      if (drive) {
+        (void)host.send(scout_mini::encode_motion(0.6, 0, 0, {}).frame);
+      }
+      clock.advance_by(5ms);
+    }
+  };
+  (void)host.send(scout_mini::encode_control_mode(ControlMode::kCan));
+  step(50ms, false);
+  ASSERT_EQ(base.mode(), ControlMode::kCan);
+  // First command at t0; nothing moves for 40 ms, then the base accelerates.
+  step(35ms, true);
+  EXPECT_EQ(base.velocity().vx_mps, 0.0) << "still within the command latency";
+  step(20ms, true);
+  EXPECT_GT(base.velocity().vx_mps, 0.0) << "the first command took effect";
+  step(1s, true);
+  EXPECT_NEAR(base.velocity().vx_mps, 0.6, 1e-9) << "the true velocity is exact";
+  reported.clear();
+  step(1s, true);
+  ASSERT_GE(reported.size(), 45U);
+  double mean = 0;
+  int differing = 0;
+  for (double v : reported) {
+    mean += v / static_cast<double>(reported.size());
+    if (std::abs(v - 0.6) >= 0.001) ++differing;
+  }
+  EXPECT_NEAR(mean, 0.6, 0.02);
+  EXPECT_GT(differing, 30) << "the reported velocity carries noise";
+  step(1s, false);  // no commands for 500 ms: the base stops by itself
+  reported.clear();
+  step(200ms, false);
+  ASSERT_FALSE(reported.empty());
+  for (double v : reported)
+    EXPECT_EQ(v, 0.0) << "standing: the encoders read zero";
+}

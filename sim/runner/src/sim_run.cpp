@@ -30,6 +30,9 @@ SimWorldConfig world_config(const firmware::DaemonConfig& cfg, uint32_t seed) {
   w.footprint_y_max_m = cfg.costmap.footprint_y_max_m;
   w.base.linear_accel_mps2 = cfg.limits.linear_accel_max_mps2;
   w.base.angular_accel_radps2 = cfg.limits.angular_accel_max_radps2;
+  w.base.command_latency = std::chrono::milliseconds(20);  // motor controllers' reaction
+  w.base.feedback_noise_rel = 0.02;                        // slip + encoders: odometry drifts
+  w.base.seed = seed;
   return w;
 }
 

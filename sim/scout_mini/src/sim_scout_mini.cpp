@@ -10,7 +10,7 @@ namespace fault = scout_mini::fault;
 namespace id = scout_mini::id;
 
 SimScoutMini::SimScoutMini(hal::CanBus& bus, const SimScoutConfig& config)
-    : bus_(bus), config_(config) {}
+    : bus_(bus), config_(config), rng_(config.seed) {}
 
 uint16_t SimScoutMini::fault_word() const {
   uint16_t w = 0;
@@ -48,6 +48,7 @@ void SimScoutMini::set_feedback_silent(bool silent) {
 void SimScoutMini::power_cycle() {
   mode_ = ControlMode::kStandby;
   target_ = {0, 0, 0};
+  pending_.clear();
   velocity_ = {0, 0, 0};
   has_command_ = false;
   timed_out_ = false;
@@ -68,9 +69,10 @@ void SimScoutMini::receive(hal::Nanos now) {
       const auto cmd = scout_mini::decode_motion_command(f);
       if (cmd && mode_ == ControlMode::kCan) {
         auto clamp = [](double v, double lim) { return std::clamp(v, -lim, lim); };
-        target_ = {clamp(cmd->vx_mps, config_.limits.vx_max_mps),
-                   clamp(cmd->wz_radps, config_.limits.wz_max_radps),
-                   clamp(cmd->vy_mps, config_.limits.vy_max_mps)};
+        pending_.push_back({now + config_.command_latency,
+                            {clamp(cmd->vx_mps, config_.limits.vx_max_mps),
+                             clamp(cmd->wz_radps, config_.limits.wz_max_radps),
+                             clamp(cmd->vy_mps, config_.limits.vy_max_mps)}});
         last_command_ = now;
         has_command_ = true;
         timed_out_ = false;
@@ -103,8 +105,13 @@ void SimScoutMini::advance(hal::Nanos now) {
   const double dt = static_cast<double>((now - last_step_).count()) * 1e-9;
   last_step_ = now;
   if (dt <= 0) return;
+  while (!pending_.empty() && pending_.front().apply_at <= now) {
+    target_ = pending_.front().target;
+    pending_.pop_front();
+  }
   if (has_command_ && now - last_command_ > config_.command_timeout) {
     target_ = {0, 0, 0};  // the real base's 500 ms command timeout
+    pending_.clear();
     has_command_ = false;
     timed_out_ = true;
   }
@@ -149,7 +156,13 @@ void SimScoutMini::publish(hal::Nanos now) {
   if (now >= next_fast_) {
     next_fast_ += std::chrono::milliseconds(20);
     if (next_fast_ <= now) next_fast_ = now + std::chrono::milliseconds(20);
-    (void)bus_.send(scout_mini::encode(velocity_));
+    scout_mini::MotionState reported = velocity_;
+    if (config_.feedback_noise_rel > 0) {
+      reported.vx_mps *= 1.0 + config_.feedback_noise_rel * unit_(rng_);
+      reported.vy_mps *= 1.0 + config_.feedback_noise_rel * unit_(rng_);
+      reported.wz_radps *= 1.0 + config_.feedback_noise_rel * unit_(rng_);
+    }
+    (void)bus_.send(scout_mini::encode(reported));
     (void)bus_.send(scout_mini::encode(lights_));
     for (uint8_t m = 1; m <= 4; ++m) {
       const double wheel = velocity_.vx_mps +

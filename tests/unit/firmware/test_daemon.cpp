@@ -1,17 +1,16 @@
 // companiond's task table and daemon on the simulated clock, with a real NOTIFY_SOCKET.
 #include <gtest/gtest.h>
 #include <spdlog/sinks/ringbuffer_sink.h>
-
-#include <nlohmann/json.hpp>
 #include <unistd.h>
 
 #include <algorithm>
-#include <cstdio>
-#include <fstream>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
+#include <fstream>
 #include <functional>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <numbers>
 #include <thread>
 

@@ -5,6 +5,8 @@
 // be injected. Time is passed in (step()); it only sees the bus, never the driver.
 #include <array>
 #include <cstdint>
+#include <deque>
+#include <random>
 
 #include "hal/can/can_bus.hpp"
 #include "scout_mini/odometry.hpp"
@@ -16,6 +18,12 @@ struct SimScoutConfig {
   double linear_accel_mps2 = 1.5;
   double angular_accel_radps2 = 3.0;
   hal::Nanos command_timeout = std::chrono::milliseconds(500);
+  // The motor controllers' reaction: a 0x111 takes effect this long after it arrived.
+  hal::Nanos command_latency{0};
+  // Reported (0x221) velocity = true velocity x (1 + N(0, this)): wheel slip and encoder error,
+  // which the daemon's odometry integrates into drift. Zero while standing (encoders read 0).
+  double feedback_noise_rel = 0.0;
+  uint32_t seed = 1;
   double battery_v = 25.2;
   double track_m = 0.45;                              // wheel track, for the 0x311 wheel odometers
   scout_mini::MotionLimits limits{3.0, 2.0, 2.5235};  // firmware limits
@@ -55,6 +63,13 @@ class SimScoutMini {
   SimScoutConfig config_;
   scout_mini::ControlMode mode_ = scout_mini::ControlMode::kStandby;
   scout_mini::MotionState target_{0, 0, 0};
+  struct Pending {
+    hal::Nanos apply_at;
+    scout_mini::MotionState target;
+  };
+  std::deque<Pending> pending_;  // received commands not yet in effect (command_latency)
+  std::mt19937 rng_;
+  std::normal_distribution<double> unit_{0.0, 1.0};
   scout_mini::MotionState velocity_{0, 0, 0};
   scout_mini::Pose2D pose_;
   double left_mm_ = 0, right_mm_ = 0;
