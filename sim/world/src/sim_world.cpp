@@ -1,10 +1,16 @@
 #include "sim/sim_world.hpp"
 
+#include <fcntl.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <limits>
+
+#include "hal/serial_port.hpp"
 
 namespace sim {
 
@@ -67,7 +73,9 @@ SimWorld::SimWorld(Scenario scenario, const SimWorldConfig& config, hal::Clock& 
   prev_robot_ = scenario_.robot_start;
 }
 
-SimWorld::~SimWorld() = default;
+SimWorld::~SimWorld() {
+  if (tracker_fd_ >= 0) ::close(tracker_fd_);
+}
 
 std::unique_ptr<hal::CanBus> SimWorld::take_base_bus() {
   return std::move(daemon_bus_);
@@ -78,7 +86,13 @@ std::unique_ptr<hal::VirtualCanBus> SimWorld::open_can_sniffer() {
 }
 
 std::unique_ptr<amfitrack::PacketLink> SimWorld::take_tracker_link() {
-  return tracker_.host_link();
+  std::array<int, 2> fds{-1, -1};
+  if (tracker_fd_ >= 0 || ::socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, fds.data()) != 0) {
+    return nullptr;
+  }
+  tracker_fd_ = fds[0];
+  (void)::fcntl(tracker_fd_, F_SETFL, ::fcntl(tracker_fd_, F_GETFL) | O_NONBLOCK);
+  return std::make_unique<amfitrack::SerialCobsLink>(hal::adopt_serial_fd(fds[1]));
 }
 
 std::unique_ptr<hal::DatagramSource> SimWorld::take_lidar_source() {
@@ -161,6 +175,7 @@ void SimWorld::step(hal::Nanos now) {
     base_->step(last_step_);
     update_tracker_pose();
     tracker_.step(last_step_);
+    if (tracker_fd_ >= 0) (void)tracker_.pump_cobs(tracker_fd_);
     cylinders_.clear();
     cylinders_.push_back({{person_.x_m, person_.y_m}, scenario_.person_radius_m, 1.75});
     for (const Pedestrian& p : crowd_.people())

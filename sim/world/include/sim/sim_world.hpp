@@ -49,6 +49,9 @@ class SimWorld {
 
   // The daemon's ends of the three devices (each may be taken once).
   std::unique_ptr<hal::CanBus> take_base_bus();
+  // The tracker as on its UART: COBS-framed Amfiprot bytes over a local stream socket, read by
+  // the daemon's serial link (framing, CRC and all). Unix sockets deliver within the write, so
+  // the simulated clock stays deterministic.
   std::unique_ptr<amfitrack::PacketLink> take_tracker_link();
   std::unique_ptr<hal::DatagramSource> take_lidar_source();
   // Another endpoint on the base's CAN bus that sees every frame (captures, tests).
@@ -91,6 +94,7 @@ class SimWorld {
   std::unique_ptr<hal::VirtualCanBus> daemon_bus_;  // until taken
   std::unique_ptr<SimScoutMini> base_;
   SimAmfitrack tracker_;
+  int tracker_fd_ = -1;  // the device's end of the tracker's byte stream
   SimVlp16 lidar_;
   std::shared_ptr<hal::DatagramQueue> lidar_queue_;
   Crowd crowd_;
