@@ -137,6 +137,14 @@ core::MppiConfig mppi_config(const DaemonConfig& cfg) {
   return c;
 }
 
+core::PidFollowerConfig pid_follower_config(const DaemonConfig& cfg) {
+  core::PidFollowerConfig c;
+  c.limits = core::TwistLimits{cfg.limits.vx_max_mps, cfg.limits.vy_max_mps, cfg.limits.wz_max_radps};
+  c.linear_accel_mps2 = cfg.limits.linear_accel_max_mps2;
+  c.angular_accel_radps2 = cfg.limits.angular_accel_max_radps2;
+  return c;
+}
+
 const char* side_of_person(int index, int points) {
   if (index < 0 || points <= 0) return "-";
   // phi = 0 is ahead of the person, counter-clockwise: 90 deg is their left.
@@ -168,6 +176,8 @@ Daemon::Daemon(const DaemonConfig& cfg, hal::SystemdNotifier& notifier)
       lidar_warning_(core::from_ms(cfg.logging.warning_interval_ms)),
       space_(interactive_space_config(cfg)),
       mppi_(mppi_config(cfg)),
+      pid_(pid_follower_config(cfg)),
+      use_pid_(cfg.control.controller == "pid_follower"),
       person_path_(static_cast<size_t>(cfg.mppi.horizon_steps) + 1),
       goal_path_(person_path_.size()),
       gate_(stop_limits(cfg)),
@@ -397,7 +407,16 @@ void Daemon::policy_task(const core::Tick& tick) {
                           th ? th->value.confidence : core::TrackerConfidence::kUnknown);
     space_.update(h.pose_base, robot_odom, *map);
     core::Selection s = core::select_by_objective(space_);
-    if (policy_ && s.status == core::GoalStatus::kOk) {
+    const std::string& selector = cfg_.policy.selector;
+    if (selector == "fixed_behind" || selector == "fixed_side") {
+      // Evaluation baselines: one point of W, free or not (phi = pi behind, pi/2 the left side).
+      const int n = space_.config().points;
+      const int index = selector == "fixed_behind" ? n / 2 : n / 4;
+      s.status = core::GoalStatus::kOk;
+      s.index = index;
+      s.goal_base = space_.candidates()[static_cast<size_t>(index)].base;
+      g.selector = selector == "fixed_behind" ? "fixed_behind" : "fixed_side";
+    } else if (policy_ && selector == "auto" && s.status == core::GoalStatus::kOk) {
       // The learned selector: the paper's observation, masked argmax over P.
       core::ObservationInputs oi;
       oi.space = &space_;
@@ -443,8 +462,13 @@ void Daemon::control_task(const core::Tick& tick) {
   // robot the controlled way (the supervisor says why when an input is missing).
   core::BodyVelocity requested{};
   bool tracking = false;
-  if (allowed) tracking = run_controller(tick.now, requested);
-  if (!tracking) mppi_.reset();  // a later start must not follow a stale plan
+  if (allowed) {
+    tracking = use_pid_ ? run_pid_follower(tick.now, requested) : run_controller(tick.now, requested);
+  }
+  if (!tracking) {  // a later start must not follow a stale plan
+    mppi_.reset();
+    pid_.reset();
+  }
   control_state_.tracking = tracking;
   const core::BodyVelocity cmd = gate_.update(allowed && tracking, requested, tick.now);
   last_command_ = core::Twist{cmd.vx_mps, cmd.vy_mps, cmd.wz_radps};
@@ -461,6 +485,19 @@ void Daemon::control_task(const core::Tick& tick) {
                               hal::to_string(r), base_->counters().write_errors);
     }
   }
+}
+
+bool Daemon::run_pid_follower(Nanos now, core::BodyVelocity& requested) {
+  const auto track = human_track_.read();
+  const auto base = base_health_.read();
+  if (!track || !track->value.valid || !base || base->value.odom_stamp == core::kNever) {
+    return false;
+  }
+  const core::HumanState h = core::human_state(track->value, now, base->value.odom, human_config_);
+  const core::Twist u = pid_.step({h.pose_base.x_m, h.pose_base.y_m}, now);
+  ++control_state_.runs;
+  requested = core::BodyVelocity{u.vx, u.vy, u.wz};
+  return true;
 }
 
 bool Daemon::run_controller(Nanos now, core::BodyVelocity& requested) {

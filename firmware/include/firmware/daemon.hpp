@@ -15,6 +15,7 @@
 #include "core/channel/latest_value.hpp"
 #include "core/channel/snapshot_channel.hpp"
 #include "core/control/mppi.hpp"
+#include "core/control/pid_follower.hpp"
 #include "core/geometry/pose_history.hpp"
 #include "core/human/human_ekf.hpp"
 #include "core/perception/costmap.hpp"
@@ -97,7 +98,8 @@ struct CompanionGoal {
   core::Pose2 goal_base;               // q^d in base_link at the time of the choice
   core::Pose2 goal_odom;               // the same in odom
   core::Pose2 person_odom;             // the person when q^d was chosen (q^d moves with them)
-  const char* selector = "objective";  // static text: "objective" (or the policy, issue 6)
+  // Static text: "objective", "policy", "fixed_behind", "fixed_side" (policy.selector).
+  const char* selector = "objective";
 };
 // What the control task publishes: how the controller did on its latest run.
 struct ControlStatus {
@@ -116,6 +118,7 @@ struct ControlStatus {
 const char* side_of_person(int index, int points);
 core::InteractiveSpaceConfig interactive_space_config(const DaemonConfig& cfg);
 core::MppiConfig mppi_config(const DaemonConfig& cfg);
+core::PidFollowerConfig pid_follower_config(const DaemonConfig& cfg);
 
 core::SupervisorConfig supervisor_config(const DaemonConfig& cfg);
 core::StopLimits stop_limits(const DaemonConfig& cfg);
@@ -195,6 +198,7 @@ class Daemon {
  private:
   // One MPPI-CBF step toward the current goal; false when there is nothing to track.
   bool run_controller(core::Nanos now, core::BodyVelocity& requested);
+  bool run_pid_follower(core::Nanos now, core::BodyVelocity& requested);
   std::string safety_text(const SafetySnapshot& s) const;
   std::string tracker_text(core::Nanos now) const;
   std::string lidar_text(core::Nanos now) const;
@@ -255,6 +259,8 @@ class Daemon {
 
   // control task state
   core::Mppi mppi_;
+  core::PidFollower pid_;
+  bool use_pid_ = false;  // control.controller: pid_follower (evaluation baseline)
   std::vector<core::Pose2> person_path_;  // the person's predicted poses at the MPPI steps
   std::vector<core::Pose2> goal_path_;    // q^d carried along person_path_
   core::Twist last_command_;              // the gate's previous output (MPPI's start control)

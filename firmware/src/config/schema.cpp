@@ -602,6 +602,25 @@ std::vector<FieldSpec> build() {
        0,
        0,
        {}},
+      {"policy.selector",
+       "name",
+       "How q^d is chosen. auto: the learned policy when policy.file is set, else the objective "
+       "argmin. objective: always the argmin of G over P. fixed_behind / fixed_side: the "
+       "baselines of the evaluation, the point of W straight behind / on the left of the person, "
+       "free or not (they show what adaptive selection is worth).",
+       FIELD(policy.selector),
+       0,
+       0,
+       {"auto", "objective", "fixed_behind", "fixed_side"}},
+      {"control.controller",
+       "name",
+       "mppi_cbf: the paper's controller (MPPI with the DCBF cost, QP repair). pid_follower: the "
+       "evaluation's PID baseline (bearing -> wz, distance -> vx, 1 m behind the person, no "
+       "obstacle avoidance). Both pass the supervisor's gate and the velocity limits.",
+       FIELD(control.controller),
+       0,
+       0,
+       {"mppi_cbf", "pid_follower"}},
       {"objective.alpha",
        "1/m",
        "alpha: weight of the distance from a candidate to the person in G (not given in the "

@@ -114,8 +114,13 @@ struct DaemonConfig {
   } objective;
 
   struct Policy {
-    std::string file;  // empty: the objective argmin selects
+    std::string file;      // empty: the objective argmin selects
+    std::string selector;  // auto, objective, fixed_behind, fixed_side
   } policy;
+
+  struct Control {
+    std::string controller;  // mppi_cbf, pid_follower
+  } control;
 
   struct Mppi {
     int64_t horizon_steps = 0;
