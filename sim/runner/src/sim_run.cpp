@@ -61,8 +61,11 @@ SimRunResult run_simulation(const SimRunOptions& o) {
   using Clock = std::chrono::steady_clock;
   const auto wall_start = Clock::now();
   SimRunResult result;
+  // Quiet: warnings and above (a caller that asked for less, e.g. companion-eval running trials
+  // in parallel, keeps its level; the level is global, so it is only ever raised here).
   const auto level = spdlog::get_level();
-  if (o.quiet) spdlog::set_level(spdlog::level::warn);
+  const bool raise = o.quiet && level < spdlog::level::warn;
+  if (raise) spdlog::set_level(spdlog::level::warn);
 
   hal::SimClock clock;
   hal::SystemdNotifier notifier;  // no NOTIFY_SOCKET in a simulation: a no-op
@@ -123,7 +126,7 @@ SimRunResult run_simulation(const SimRunOptions& o) {
   result.samples = recorder.samples();
   result.final_status = daemon.status_line();
   result.wall_s = std::chrono::duration<double>(Clock::now() - wall_start).count();
-  spdlog::set_level(level);
+  if (raise) spdlog::set_level(level);
   return result;
 }
 
