@@ -139,7 +139,8 @@ core::MppiConfig mppi_config(const DaemonConfig& cfg) {
 
 core::PidFollowerConfig pid_follower_config(const DaemonConfig& cfg) {
   core::PidFollowerConfig c;
-  c.limits = core::TwistLimits{cfg.limits.vx_max_mps, cfg.limits.vy_max_mps, cfg.limits.wz_max_radps};
+  c.limits =
+      core::TwistLimits{cfg.limits.vx_max_mps, cfg.limits.vy_max_mps, cfg.limits.wz_max_radps};
   c.linear_accel_mps2 = cfg.limits.linear_accel_max_mps2;
   c.angular_accel_radps2 = cfg.limits.angular_accel_max_radps2;
   return c;
@@ -463,7 +464,8 @@ void Daemon::control_task(const core::Tick& tick) {
   core::BodyVelocity requested{};
   bool tracking = false;
   if (allowed) {
-    tracking = use_pid_ ? run_pid_follower(tick.now, requested) : run_controller(tick.now, requested);
+    tracking =
+        use_pid_ ? run_pid_follower(tick.now, requested) : run_controller(tick.now, requested);
   }
   if (!tracking) {  // a later start must not follow a stale plan
     mppi_.reset();

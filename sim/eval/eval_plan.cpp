@@ -8,10 +8,8 @@ namespace eval {
 
 const std::vector<Method>& all_methods() {
   static const std::vector<Method> kMethods{
-      {"objective", "objective", "mppi_cbf"},
-      {"fixed_behind", "fixed_behind", "mppi_cbf"},
-      {"fixed_side", "fixed_side", "mppi_cbf"},
-      {"pid", "objective", "pid_follower"},
+      {"objective", "objective", "mppi_cbf"},   {"fixed_behind", "fixed_behind", "mppi_cbf"},
+      {"fixed_side", "fixed_side", "mppi_cbf"}, {"pid", "objective", "pid_follower"},
       {"policy", "auto", "mppi_cbf"},
   };
   return kMethods;

@@ -25,7 +25,7 @@ struct Case {
   std::string name;      // "open", "random", "crowd-15", "speed-1.2", "size-1.2x0.9", ...
   std::string scenario;  // built-in name, "random", or "recorded"
   int trials = 1;
-  sim::RandomScenarioOptions random;  // for "random" and its variants
+  sim::RandomScenarioOptions random;        // for "random" and its variants
   double ellipse_a_m = 0, ellipse_b_m = 0;  // > 0: interaction-space size of this case
 };
 

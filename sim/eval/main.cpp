@@ -87,7 +87,8 @@ std::string csv_row(const Outcome& o, const std::string& scenario) {
 }
 
 int run(int argc, char** argv) {
-  CLI::App app{"companion-eval: the paper's tables from the simulated world (reference/evaluation.md)"};
+  CLI::App app{
+      "companion-eval: the paper's tables from the simulated world (reference/evaluation.md)"};
   std::vector<std::string> case_names{"paper"};
   std::vector<std::string> method_names{"objective", "fixed_behind", "fixed_side", "pid"};
   int trials = 50;
@@ -107,12 +108,15 @@ int run(int argc, char** argv) {
   app.add_option("--method", method_names,
                  "methods: objective fixed_behind fixed_side pid policy (policy needs policy.file)")
       ->delimiter(',');
-  app.add_option("--trials", trials, "trials of the random cases (paper: 50)")->check(CLI::Range(1, 100000));
+  app.add_option("--trials", trials, "trials of the random cases (paper: 50)")
+      ->check(CLI::Range(1, 100000));
   app.add_option("--seed", seed, "first seed (trial i uses seed + i)");
-  app.add_option("--jobs", jobs, "trials in parallel (default: the cores)")->check(CLI::Range(1U, 256U));
+  app.add_option("--jobs", jobs, "trials in parallel (default: the cores)")
+      ->check(CLI::Range(1U, 256U));
   app.add_option("--out", out_dir, "output directory (trials.csv, summary.md)");
   app.add_option("-c,--config", config_path, "daemon configuration (default: built-in defaults)");
-  app.add_option("--pedestrians", pedestrians, "recorded pedestrians (frame id x y) to follow through");
+  app.add_option("--pedestrians", pedestrians,
+                 "recorded pedestrians (frame id x y) to follow through");
   app.add_option("--frame-period", frame_period, "seconds between consecutive frame values")
       ->check(CLI::PositiveNumber);
   app.add_option("--follow", follow, "recorded person to accompany (default: who walks farthest)");
@@ -150,8 +154,8 @@ int run(int argc, char** argv) {
       return 2;
     }
     std::string error;
-    recorded = sim::recorded_scenario(ds.data, follow >= 0 ? follow : sim::longest_walk(ds.data),
-                                      &error);
+    recorded =
+        sim::recorded_scenario(ds.data, follow >= 0 ? follow : sim::longest_walk(ds.data), &error);
     if (!recorded) {
       std::cerr << pedestrians << ": " << error << "\n";
       return 2;
@@ -237,9 +241,11 @@ int run(int argc, char** argv) {
       "in sim/runner/include/sim/run_metrics.hpp.\n",
       plan.size(), wall, 60.0 * static_cast<double>(plan.size()) / wall, jobs);
   for (const auto& c : cases) {
-    md += fmt::format("\n## {} ({} trial{} per method)\n\n", c.name, c.trials, c.trials == 1 ? "" : "s");
-    md += "| method | SR % | UT s | e_x m | e_y m | e_θ rad | in ellipse s | min dist. person m | "
-          "collisions | control p50 / p99 ms |\n|---|---|---|---|---|---|---|---|---|---|\n";
+    md += fmt::format("\n## {} ({} trial{} per method)\n\n", c.name, c.trials,
+                      c.trials == 1 ? "" : "s");
+    md +=
+        "| method | SR % | UT s | e_x m | e_y m | e_θ rad | in ellipse s | min dist. person m | "
+        "collisions | control p50 / p99 ms |\n|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& m : methods) {
       std::vector<double> ut, ex, ey, et, ell, dmin, ctl;
       int ok = 0, n = 0, collisions = 0;
@@ -266,7 +272,8 @@ int run(int argc, char** argv) {
     }
   }
   std::ofstream(out_dir + "/summary.md") << md;
-  std::cout << "\n" << md << fmt::format("\nwrote {}/trials.csv and {}/summary.md\n", out_dir, out_dir);
+  std::cout << "\n"
+            << md << fmt::format("\nwrote {}/trials.csv and {}/summary.md\n", out_dir, out_dir);
   return 0;
 }
 

@@ -22,17 +22,17 @@ Twist PidFollower::step(const Point2& person, Nanos now) {
     de_d = (e_d - last_distance_error_) / dt;
     de_b = wrap_angle(bearing - last_bearing_) / dt;
     // Integrals clamped (anti-windup): they can at most add one limit's worth.
-    distance_integral_ =
-        std::clamp(distance_integral_ + e_d * dt, -cfg_.limits.vx / std::max(cfg_.ki_distance, 1e-9),
-                   cfg_.limits.vx / std::max(cfg_.ki_distance, 1e-9));
-    bearing_integral_ =
-        std::clamp(bearing_integral_ + bearing * dt, -cfg_.limits.wz / std::max(cfg_.ki_bearing, 1e-9),
-                   cfg_.limits.wz / std::max(cfg_.ki_bearing, 1e-9));
+    distance_integral_ = std::clamp(distance_integral_ + e_d * dt,
+                                    -cfg_.limits.vx / std::max(cfg_.ki_distance, 1e-9),
+                                    cfg_.limits.vx / std::max(cfg_.ki_distance, 1e-9));
+    bearing_integral_ = std::clamp(bearing_integral_ + bearing * dt,
+                                   -cfg_.limits.wz / std::max(cfg_.ki_bearing, 1e-9),
+                                   cfg_.limits.wz / std::max(cfg_.ki_bearing, 1e-9));
   }
-  double vx = cfg_.kp_distance * e_d + cfg_.ki_distance * distance_integral_ +
-              cfg_.kd_distance * de_d;
-  double wz = cfg_.kp_bearing * bearing + cfg_.ki_bearing * bearing_integral_ +
-              cfg_.kd_bearing * de_b;
+  double vx =
+      cfg_.kp_distance * e_d + cfg_.ki_distance * distance_integral_ + cfg_.kd_distance * de_d;
+  double wz =
+      cfg_.kp_bearing * bearing + cfg_.ki_bearing * bearing_integral_ + cfg_.kd_bearing * de_b;
   // Facing away from the person: turn first, do not drive.
   if (std::abs(bearing) > 1.2) vx = 0;
   vx = std::clamp(vx, -cfg_.limits.vx, cfg_.limits.vx);

@@ -1,0 +1,140 @@
+#!/usr/bin/python3
+"""Plots of a companion-eval output directory (Debian's python3-matplotlib, no other modules).
+
+    /usr/bin/python3 sim/eval/plot_eval.py OUT_DIR   (the system Python: Debian's matplotlib)
+
+Writes into OUT_DIR/plots/:
+  sides-<case>.png       where the robot was around the person (polar, share of moving time),
+                         one panel per method (from trials.csv)
+  trajectories-<case>.png  robot, person and chosen points of the first trial per method
+  errors-<case>.png      e_x, e_y, e_theta over time (q^d - robot, robot frame), first trial
+The last two need the per-trial samples (companion-eval --samples).
+"""
+import csv
+import math
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+SIDES = ["front", "front_left", "left", "behind_left", "behind", "behind_right", "right",
+         "front_right"]
+
+
+def read_csv(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def sides_plot(case, rows, out):
+    methods = sorted({r["method"] for r in rows})
+    fig, axes = plt.subplots(1, len(methods), subplot_kw={"projection": "polar"},
+                             figsize=(3.2 * len(methods), 3.4), squeeze=False)
+    for ax, method in zip(axes[0], methods):
+        totals = [0.0] * 8
+        for r in rows:
+            if r["method"] == method:
+                for i, s in enumerate(SIDES):
+                    totals[i] += float(r["side_" + s])
+        total = sum(totals) or 1.0
+        angles = [i * math.pi / 4 for i in range(8)]  # 0 = ahead of the person, counter-clockwise
+        ax.bar(angles, [100.0 * t / total for t in totals], width=math.pi / 4 * 0.9,
+               color="#c0392b", alpha=0.7)
+        ax.set_theta_zero_location("N")  # the person walks up the page
+        ax.set_title(method, fontsize=10)
+        ax.set_xticks(angles)
+        ax.set_xticklabels(["front", "", "left", "", "behind", "", "right", ""], fontsize=8)
+    fig.suptitle(f"{case}: the robot around the person (% of moving time)", fontsize=11)
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+
+
+def first_samples(out_dir, case, rows):
+    picked = {}
+    for r in rows:
+        path = os.path.join(out_dir, "samples", case, f"{r['method']}-{r['seed']}.csv")
+        if r["method"] not in picked and os.path.exists(path):
+            picked[r["method"]] = read_csv(path)
+    return picked
+
+
+def trajectories_plot(case, samples, out):
+    fig, axes = plt.subplots(1, len(samples), figsize=(4.2 * len(samples), 4.2), squeeze=False)
+    for ax, (method, s) in zip(axes[0], sorted(samples.items())):
+        ax.plot([float(x["person_x_m"]) for x in s], [float(x["person_y_m"]) for x in s],
+                color="#1f5fbf", label="person")
+        ax.plot([float(x["robot_x_m"]) for x in s], [float(x["robot_y_m"]) for x in s],
+                color="#c0392b", label="robot")
+        g = [x for x in s if x["has_goal"] == "1" and x["active"] == "1"]
+        ax.scatter([float(x["goal_x_m"]) for x in g[::3]], [float(x["goal_y_m"]) for x in g[::3]],
+                   s=4, color="#2a9d3a", label="q^d")
+        ax.set_aspect("equal")
+        ax.set_title(method, fontsize=10)
+        ax.grid(alpha=0.3)
+    axes[0][0].legend(fontsize=8)
+    fig.suptitle(f"{case}: trajectories (first trial per method)", fontsize=11)
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+
+
+def errors_plot(case, samples, out):
+    fig, axes = plt.subplots(3, 1, figsize=(9, 6.5), sharex=True)
+    for method, s in sorted(samples.items()):
+        t, ex, ey, et = [], [], [], []
+        for x in s:
+            if x["has_goal"] != "1" or x["active"] != "1":
+                continue
+            rx, ry, rth = float(x["robot_x_m"]), float(x["robot_y_m"]), float(x["robot_theta_rad"])
+            dx, dy = float(x["goal_x_m"]) - rx, float(x["goal_y_m"]) - ry
+            t.append(float(x["t_s"]))
+            ex.append(math.cos(rth) * dx + math.sin(rth) * dy)
+            ey.append(-math.sin(rth) * dx + math.cos(rth) * dy)
+            # q^d faces the person's heading; the samples carry the person's heading.
+            e = float(x["person_theta_rad"]) - rth
+            et.append(math.atan2(math.sin(e), math.cos(e)))
+        for ax, v in zip(axes, (ex, ey, et)):
+            ax.plot(t, v, label=method, linewidth=1)
+    for ax, name in zip(axes, ("e_x [m]", "e_y [m]", "e_theta [rad]")):
+        ax.set_ylabel(name)
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=8, ncol=4)
+    axes[2].set_xlabel("t [s]")
+    fig.suptitle(f"{case}: tracking error q^d - robot in the robot frame (first trial)",
+                 fontsize=11)
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+
+
+def main():
+    if len(sys.argv) != 2:
+        print(__doc__)
+        return 2
+    out_dir = sys.argv[1]
+    rows = read_csv(os.path.join(out_dir, "trials.csv"))
+    plots = os.path.join(out_dir, "plots")
+    os.makedirs(plots, exist_ok=True)
+    written = []
+    for case in sorted({r["case"] for r in rows}):
+        case_rows = [r for r in rows if r["case"] == case]
+        path = os.path.join(plots, f"sides-{case}.png")
+        sides_plot(case, case_rows, path)
+        written.append(path)
+        samples = first_samples(out_dir, case, case_rows)
+        if samples:
+            for name, fn in (("trajectories", trajectories_plot), ("errors", errors_plot)):
+                path = os.path.join(plots, f"{name}-{case}.png")
+                fn(case, samples, path)
+                written.append(path)
+    for p in written:
+        print(p)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,88 @@
+// companion-eval end to end, reduced (CI checks the pipeline, not the numbers): cases and
+// methods by name, parallel trials, one CSV row per trial, the tables, the plots; the
+// recorded-pedestrian mode; clear refusals.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "support/child_process.hpp"
+
+using namespace std::chrono_literals;
+using test_support::ChildProcess;
+
+namespace {
+std::string slurp(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+size_t lines(const std::string& s) {
+  size_t n = 0;
+  for (char c : s)
+    n += c == '\n' ? 1 : 0;
+  return n;
+}
+}  // namespace
+
+TEST(CompanionEval, RunsCasesAndMethodsByNameAndWritesTablesCsvAndPlots) {
+  const std::string out = ::testing::TempDir() + "companion-eval-ci";
+  ChildProcess p({COMPANION_EVAL_PATH, "--case", "corridor,crowd-5", "--trials", "2", "--method",
+                  "objective,fixed_side,pid", "--duration-s", "8", "--jobs", "2", "--samples",
+                  "--out", out});
+  ASSERT_TRUE(p.started());
+  ASSERT_EQ(p.wait(600s), 0) << p.output();
+  const std::string csv = slurp(out + "/trials.csv");
+  // corridor: 1 trial x 3 methods; crowd-5: 2 trials x 3 methods; plus the header.
+  EXPECT_EQ(lines(csv), 1U + 3U + 6U) << csv;
+  EXPECT_NE(csv.find("crowd-5,fixed_side,2,crowd-5-2,"), std::string::npos) << csv;
+  const std::string md = slurp(out + "/summary.md");
+  EXPECT_NE(md.find("## corridor (1 trial per method)"), std::string::npos) << md;
+  EXPECT_NE(md.find("## crowd-5 (2 trials per method)"), std::string::npos) << md;
+  EXPECT_NE(md.find("| method | SR % | UT s | e_x m | e_y m | e_θ rad |"), std::string::npos);
+  EXPECT_NE(md.find("| pid | "), std::string::npos);
+  EXPECT_NE(md.find("trials/min"), std::string::npos);
+  EXPECT_FALSE(slurp(out + "/samples/corridor/objective-1.csv").empty());
+
+  ChildProcess plot({"/usr/bin/python3", COMPANION_PLOT_SCRIPT, out});
+  ASSERT_TRUE(plot.started());
+  ASSERT_EQ(plot.wait(120s), 0) << plot.output();
+  for (const char* f : {"sides-corridor.png", "trajectories-crowd-5.png", "errors-corridor.png"}) {
+    const std::string png = slurp(out + "/plots/" + f);
+    ASSERT_GT(png.size(), 1000U) << f;
+    EXPECT_EQ(png.substr(1, 3), "PNG") << f;
+  }
+}
+
+TEST(CompanionEval, FollowsARecordedPersonFromAnyDatasetFile) {
+  const std::string out = ::testing::TempDir() + "companion-eval-recorded";
+  ChildProcess p({COMPANION_EVAL_PATH, "--pedestrians", COMPANION_PEDESTRIANS "/biwi_hotel.txt",
+                  "--frame-period", "0.4", "--follow", "203", "--method", "objective",
+                  "--duration-s", "8", "--out", out});
+  ASSERT_TRUE(p.started());
+  ASSERT_EQ(p.wait(300s), 0) << p.output();
+  const std::string csv = slurp(out + "/trials.csv");
+  EXPECT_EQ(lines(csv), 2U);
+  EXPECT_NE(csv.find("recorded,objective,1,recorded-203,"), std::string::npos) << csv;
+}
+
+TEST(CompanionEval, RefusesUnknownCasesMethodsAndPersons) {
+  ChildProcess a({COMPANION_EVAL_PATH, "--case", "moon"});
+  ASSERT_TRUE(a.started());
+  EXPECT_EQ(a.wait(30s), 2);
+  EXPECT_NE(a.output().find("unknown case 'moon'"), std::string::npos) << a.output();
+  ChildProcess b({COMPANION_EVAL_PATH, "--method", "teleport"});
+  ASSERT_TRUE(b.started());
+  EXPECT_EQ(b.wait(30s), 2);
+  EXPECT_NE(b.output().find("unknown method 'teleport'"), std::string::npos) << b.output();
+  ChildProcess c({COMPANION_EVAL_PATH, "--method", "policy"});
+  ASSERT_TRUE(c.started());
+  EXPECT_EQ(c.wait(30s), 2);
+  EXPECT_NE(c.output().find("needs a policy file"), std::string::npos) << c.output();
+  ChildProcess d({COMPANION_EVAL_PATH, "--pedestrians", COMPANION_PEDESTRIANS "/biwi_hotel.txt",
+                  "--follow", "99999"});
+  ASSERT_TRUE(d.started());
+  EXPECT_EQ(d.wait(30s), 2);
+  EXPECT_NE(d.output().find("no person with id 99999"), std::string::npos) << d.output();
+}
