@@ -37,12 +37,12 @@ Twist PidFollower::step(const Point2& person, Nanos now) {
   if (std::abs(bearing) > 1.2) vx = 0;
   vx = std::clamp(vx, -cfg_.limits.vx, cfg_.limits.vx);
   wz = std::clamp(wz, -cfg_.limits.wz, cfg_.limits.wz);
-  if (dt > 0) {
-    const double dv = cfg_.linear_accel_mps2 * dt;
-    const double dw = cfg_.angular_accel_radps2 * dt;
-    vx = std::clamp(vx, out_.vx - dv, out_.vx + dv);
-    wz = std::clamp(wz, out_.wz - dw, out_.wz + dw);
-  }
+  // Within the base's accelerations from the previous output (the first step, with no elapsed
+  // time known, keeps it: a start from rest begins at rest).
+  const double dv = cfg_.linear_accel_mps2 * dt;
+  const double dw = cfg_.angular_accel_radps2 * dt;
+  vx = std::clamp(vx, out_.vx - dv, out_.vx + dv);
+  wz = std::clamp(wz, out_.wz - dw, out_.wz + dw);
   out_ = Twist{vx, 0.0, wz};
   last_ = now;
   has_last_ = true;

@@ -8,6 +8,7 @@
 
 #include "core/control/dcbf_repair.hpp"
 #include "core/control/mppi.hpp"
+#include "core/control/pid_follower.hpp"
 #include "core/perception/voxel_grid.hpp"
 
 using core::Nanos;
@@ -202,3 +203,37 @@ TEST(DcbfRepair, TheRepairIsTheClosestSafeControl) {
 }
 
 }  // namespace
+
+// ---- the PID follower baseline ---------------------------------------------------------------
+
+TEST(PidFollower, DrivesToOneMetreBehindTurningTowardThePerson) {
+  core::PidFollowerConfig cfg;
+  core::PidFollower pid(cfg);
+  core::Twist u;
+  for (int i = 0; i < 200; ++i)
+    u = pid.step({2.0, 0.0}, core::Nanos(std::chrono::milliseconds(10 * i)));
+  EXPECT_GT(u.vx, 0.5) << "1 m too far: forward";
+  EXPECT_NEAR(u.wz, 0.0, 1e-9);
+  EXPECT_EQ(u.vy, 0.0) << "no lateral motion";
+  pid.reset();
+  for (int i = 0; i < 200; ++i)
+    u = pid.step({1.0, 0.0}, core::Nanos(std::chrono::milliseconds(10 * i)));
+  EXPECT_NEAR(u.vx, 0.0, 1e-6) << "at 1 m: hold";
+  pid.reset();
+  for (int i = 0; i < 200; ++i)
+    u = pid.step({1.0, 0.5}, core::Nanos(std::chrono::milliseconds(10 * i)));
+  EXPECT_GT(u.wz, 0.3) << "person to the left: turn left";
+  pid.reset();
+  for (int i = 0; i < 200; ++i)
+    u = pid.step({-2.0, 0.1}, core::Nanos(std::chrono::milliseconds(10 * i)));
+  EXPECT_EQ(u.vx, 0.0) << "facing away: turn first";
+  EXPECT_LE(std::abs(u.wz), cfg.limits.wz + 1e-12);
+}
+
+TEST(PidFollower, RespectsTheAccelerationLimit) {
+  core::PidFollowerConfig cfg;
+  core::PidFollower pid(cfg);
+  (void)pid.step({5.0, 0.0}, core::Nanos(0));
+  const core::Twist u = pid.step({5.0, 0.0}, core::Nanos(std::chrono::milliseconds(10)));
+  EXPECT_LE(u.vx, cfg.linear_accel_mps2 * 0.01 + 1e-9) << "from standstill, one 10 ms step";
+}
