@@ -245,9 +245,10 @@ int run(int argc, char** argv) {
                       c.trials == 1 ? "" : "s");
     md +=
         "| method | SR % | UT s | e_x m | e_y m | e_θ rad | in ellipse s | min dist. person m | "
-        "collisions | control p50 / p99 ms |\n|---|---|---|---|---|---|---|---|---|---|\n";
+        "collisions | policy p50 / p99 ms | control p50 / p99 ms |\n"
+          "|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& m : methods) {
-      std::vector<double> ut, ex, ey, et, ell, dmin, ctl;
+      std::vector<double> ut, ex, ey, et, ell, dmin, ctl, pol;
       int ok = 0, n = 0, collisions = 0;
       for (const Outcome& o : outcomes) {
         if (o.trial.c != &c || o.trial.method->name != m.name) continue;
@@ -261,13 +262,15 @@ int run(int argc, char** argv) {
         ell.push_back(o.m.inside_ellipse_s);
         dmin.push_back(o.m.min_person_distance_m);
         ctl.insert(ctl.end(), o.control_ms.begin(), o.control_ms.end());
+        pol.insert(pol.end(), o.policy_ms.begin(), o.policy_ms.end());
       }
       if (n == 0) continue;
-      md += fmt::format("| {} | {:.0f} | {} | {} | {} | {} | {} | {} | {} | {:.2f} / {:.2f} |\n",
+      md += fmt::format("| {} | {:.0f} | {} | {} | {} | {} | {} | {} | {} | {:.3f} / {:.3f} | {:.3f} / {:.3f} |\n",
                         m.name, 100.0 * ok / n, pm(mean_std(ut), "{:.2f}"),
                         pm(mean_std(ex), "{:.3f}"), pm(mean_std(ey), "{:.3f}"),
                         pm(mean_std(et), "{:.3f}"), pm(mean_std(ell), "{:.2f}"),
-                        pm(mean_std(dmin), "{:.2f}"), collisions, sim::quantile(ctl, 0.5),
+                        pm(mean_std(dmin), "{:.2f}"), collisions, sim::quantile(pol, 0.5),
+                        sim::quantile(pol, 0.99), sim::quantile(ctl, 0.5),
                         sim::quantile(ctl, 0.99));
     }
   }

@@ -87,10 +87,22 @@ SimRunResult run_simulation(const SimRunOptions& o) {
                                 : t.spec.name == "control" ? &result.control_ms
                                                            : nullptr;
     if (into == nullptr) continue;
-    t.fn = [into, fn = t.fn](const core::Tick& tick) {
+    // Planning time counts the runs that planned: a holding control task or a policy without a
+    // person does next to nothing, and would only dilute the quantiles.
+    const bool is_control = t.spec.name == "control";
+    t.fn = [into, is_control, &daemon, fn = t.fn](const core::Tick& tick) {
       const auto t0 = Clock::now();
       fn(tick);
-      into->push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+      const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+      bool planned = false;
+      if (is_control) {
+        const auto c = daemon.control_status().read();
+        planned = c && c->value.tracking;
+      } else {
+        const auto g = daemon.goal().read();
+        planned = g && g->value.status == core::GoalStatus::kOk;
+      }
+      if (planned) into->push_back(ms);
     };
   }
   const double step_s = world.config().step_s;
