@@ -246,7 +246,7 @@ int run(int argc, char** argv) {
     md +=
         "| method | SR % | UT s | e_x m | e_y m | e_θ rad | in ellipse s | min dist. person m | "
         "collisions | policy p50 / p99 ms | control p50 / p99 ms |\n"
-          "|---|---|---|---|---|---|---|---|---|---|---|\n";
+        "|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& m : methods) {
       std::vector<double> ut, ex, ey, et, ell, dmin, ctl, pol;
       int ok = 0, n = 0, collisions = 0;
@@ -265,13 +265,13 @@ int run(int argc, char** argv) {
         pol.insert(pol.end(), o.policy_ms.begin(), o.policy_ms.end());
       }
       if (n == 0) continue;
-      md += fmt::format("| {} | {:.0f} | {} | {} | {} | {} | {} | {} | {} | {:.3f} / {:.3f} | {:.3f} / {:.3f} |\n",
-                        m.name, 100.0 * ok / n, pm(mean_std(ut), "{:.2f}"),
-                        pm(mean_std(ex), "{:.3f}"), pm(mean_std(ey), "{:.3f}"),
-                        pm(mean_std(et), "{:.3f}"), pm(mean_std(ell), "{:.2f}"),
-                        pm(mean_std(dmin), "{:.2f}"), collisions, sim::quantile(pol, 0.5),
-                        sim::quantile(pol, 0.99), sim::quantile(ctl, 0.5),
-                        sim::quantile(ctl, 0.99));
+      md += fmt::format(
+          "| {} | {:.0f} | {} | {} | {} | {} | {} | {} | {} | {:.3f} / {:.3f} | {:.3f} / {:.3f} "
+          "|\n",
+          m.name, 100.0 * ok / n, pm(mean_std(ut), "{:.2f}"), pm(mean_std(ex), "{:.3f}"),
+          pm(mean_std(ey), "{:.3f}"), pm(mean_std(et), "{:.3f}"), pm(mean_std(ell), "{:.2f}"),
+          pm(mean_std(dmin), "{:.2f}"), collisions, sim::quantile(pol, 0.5),
+          sim::quantile(pol, 0.99), sim::quantile(ctl, 0.5), sim::quantile(ctl, 0.99));
     }
   }
   std::ofstream(out_dir + "/summary.md") << md;

@@ -92,12 +92,12 @@ struct LidarHealth {
 // What the policy task publishes: the companion point q^d and how it was chosen.
 struct CompanionGoal {
   core::GoalStatus status = core::GoalStatus::kNoPerson;
-  int index = -1;                      // into W
-  int points = 0;                      // n
-  size_t free_points = 0;              // |P|
-  core::Pose2 goal_base;               // q^d in base_link at the time of the choice
-  core::Pose2 goal_odom;               // the same in odom
-  core::Pose2 person_odom;             // the person when q^d was chosen (q^d moves with them)
+  int index = -1;           // into W
+  int points = 0;           // n
+  size_t free_points = 0;   // |P|
+  core::Pose2 goal_base;    // q^d in base_link at the time of the choice
+  core::Pose2 goal_odom;    // the same in odom
+  core::Pose2 person_odom;  // the person when q^d was chosen (q^d moves with them)
   // Static text: "objective", "policy", "fixed_behind", "fixed_side" (policy.selector).
   const char* selector = "objective";
 };
@@ -260,7 +260,7 @@ class Daemon {
   // control task state
   core::Mppi mppi_;
   core::PidFollower pid_;
-  bool use_pid_ = false;  // control.controller: pid_follower (evaluation baseline)
+  bool use_pid_ = false;                  // control.controller: pid_follower (evaluation baseline)
   std::vector<core::Pose2> person_path_;  // the person's predicted poses at the MPPI steps
   std::vector<core::Pose2> goal_path_;    // q^d carried along person_path_
   core::Twist last_command_;              // the gate's previous output (MPPI's start control)
