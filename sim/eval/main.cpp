@@ -23,6 +23,7 @@
 
 #include "eval_plan.hpp"
 #include "firmware/config/config_loader.hpp"
+#include "firmware/tool_console.hpp"
 #include "sim/pedestrian_dataset.hpp"
 #include "sim/run_report.hpp"
 #include "sim/sim_run.hpp"
@@ -283,10 +284,5 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::cerr << "companion-eval: " << e.what() << "\n";
-    return 1;
-  }
+  return firmware::tool::main_guarded("companion-eval", run, argc, argv);
 }

@@ -7,17 +7,13 @@
 #include <sstream>
 
 #include "support/child_process.hpp"
+#include "support/files.hpp"
 
 using namespace std::chrono_literals;
 using test_support::ChildProcess;
+using test_support::slurp;
 
 namespace {
-std::string slurp(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
 size_t lines(const std::string& s) {
   size_t n = 0;
   for (char c : s)

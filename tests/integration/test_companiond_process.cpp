@@ -10,10 +10,12 @@
 #include <vector>
 
 #include "support/child_process.hpp"
+#include "support/files.hpp"
 #include "support/notify_socket.hpp"
 
 using namespace std::chrono_literals;
 using test_support::ChildProcess;
+using test_support::slurp;
 
 namespace {
 
@@ -155,15 +157,6 @@ TEST(Companiond, RefusesAPolicyFileThatDoesNotLoad) {
 }
 
 // ---- the main job: companiond on the simulated world ---------------------------------------
-
-namespace {
-std::string slurp(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
-}  // namespace
 
 TEST(CompanionSim, RealTimeRunAccompaniesThenSigtermStopsTheBaseAndWritesTheReport) {
   test_support::NotifySocket sock;

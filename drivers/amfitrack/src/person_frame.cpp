@@ -4,14 +4,15 @@
 #include <cmath>
 
 namespace amfitrack {
-namespace {
 
-Eigen::Matrix3d rpy(const std::array<double, 3>& a) {
+Eigen::Matrix3d rotation_rpy(const std::array<double, 3>& a) {
   return (Eigen::AngleAxisd(a[2], Eigen::Vector3d::UnitZ()) *
           Eigen::AngleAxisd(a[1], Eigen::Vector3d::UnitY()) *
           Eigen::AngleAxisd(a[0], Eigen::Vector3d::UnitX()))
       .toRotationMatrix();
 }
+
+namespace {
 
 // Below this length of the floor projection of the body x axis (i.e. within ~8 degrees of
 // vertical) the heading is undefined.
@@ -20,10 +21,10 @@ constexpr double kMinHorizontal = 0.14;
 }  // namespace
 
 PersonFrame::PersonFrame(const TrackerExtrinsics& e)
-    : r_base_source_(rpy(e.source_rpy_rad)),
+    : r_base_source_(rotation_rpy(e.source_rpy_rad)),
       t_base_source_(e.source_xyz_m[0], e.source_xyz_m[1], e.source_xyz_m[2]),
       // R_body_sensor = rpy(sensor_in_body); body axes in sensor coordinates = its transpose.
-      r_sensor_body_(rpy(e.sensor_in_body_rpy_rad).transpose()) {}
+      r_sensor_body_(rotation_rpy(e.sensor_in_body_rpy_rad).transpose()) {}
 
 std::optional<PersonInBase> PersonFrame::to_base(const SensorMeasurement& m) const {
   const auto& q = m.quaternion_xyzw;

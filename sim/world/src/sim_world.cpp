@@ -15,13 +15,6 @@
 namespace sim {
 
 namespace {
-Eigen::Matrix3d rpy(const std::array<double, 3>& a) {
-  return (Eigen::AngleAxisd(a[2], Eigen::Vector3d::UnitZ()) *
-          Eigen::AngleAxisd(a[1], Eigen::Vector3d::UnitY()) *
-          Eigen::AngleAxisd(a[0], Eigen::Vector3d::UnitX()))
-      .toRotationMatrix();
-}
-
 // The daemon's end of the lidar queue (the world keeps pushing into it).
 class SharedDatagramSource final : public hal::DatagramSource {
  public:
@@ -62,11 +55,11 @@ SimWorld::SimWorld(Scenario scenario, const SimWorldConfig& config, hal::Clock& 
       tracker_(config.tracker),
       lidar_(config.lidar),
       lidar_queue_(std::make_shared<hal::DatagramQueue>()),
-      r_base_source_(rpy(config.tracker_extrinsics.source_rpy_rad)),
+      r_base_source_(amfitrack::rotation_rpy(config.tracker_extrinsics.source_rpy_rad)),
       t_base_source_(config.tracker_extrinsics.source_xyz_m[0],
                      config.tracker_extrinsics.source_xyz_m[1],
                      config.tracker_extrinsics.source_xyz_m[2]),
-      r_body_sensor_(rpy(config.tracker_extrinsics.sensor_in_body_rpy_rad)) {
+      r_body_sensor_(amfitrack::rotation_rpy(config.tracker_extrinsics.sensor_in_body_rpy_rad)) {
   for (const Pedestrian& p : scenario_.pedestrians)
     crowd_.add(p);
   person_ = scenario_.person.pose_at(0.0);

@@ -28,6 +28,10 @@ struct PersonInBase {
   double distance_m = 0;      // planar, from the base_link origin
 };
 
+// Roll, pitch, yaw (rad) -> rotation, ZYX: R = Rz(yaw) Ry(pitch) Rx(roll) (the extrinsics'
+// convention).
+Eigen::Matrix3d rotation_rpy(const std::array<double, 3>& rpy_rad);
+
 class PersonFrame {
  public:
   explicit PersonFrame(const TrackerExtrinsics& extrinsics);
