@@ -24,6 +24,9 @@ constexpr int64_t kNotYet = std::numeric_limits<int64_t>::max();
 constexpr Nanos kGoalMaxAge = std::chrono::milliseconds(200);
 // Odometry is moved forward by its velocity for at most this long.
 constexpr double kMaxOdomLagS = 0.1;
+// A command reaches the wheels within this (CAN, the motor controllers' reaction; the Scout's
+// feedback comes every 20 ms): feedback older than that after a change does not show it yet.
+constexpr Nanos kBaseReaction = std::chrono::milliseconds(150);
 }  // namespace
 
 core::SupervisorConfig supervisor_config(const DaemonConfig& cfg) {
@@ -206,11 +209,15 @@ bool Daemon::shutdown_complete() const {
   const bool commanded_zero = s && s->value.reason == core::Reason::kShutdown && c &&
                               c->value.is_zero() && c->stamp >= s->stamp;
   if (!commanded_zero || !base_) return commanded_zero;
-  // With a base: its own feedback must confirm standstill, measured after the zero command.
+  // With a base: its own feedback must confirm standstill, measured long enough after the zero
+  // command took over that a command still in the base's pipeline would show (a base that has
+  // not started moving yet also reports zero).
   const auto b = base_health_.read();
-  const Nanos since(shutdown_seen_at_ns_.load(std::memory_order_acquire));
-  return b && b->value.feedback_stamp != core::kNever && b->value.feedback_stamp > since &&
-         b->value.vx_mps == 0.0 && b->value.vy_mps == 0.0 && b->value.wz_radps == 0.0;
+  const int64_t zero_since = zero_commanded_since_ns_.load(std::memory_order_acquire);
+  if (zero_since == kNotYet) return false;
+  return b && b->value.feedback_stamp != core::kNever &&
+         b->value.feedback_stamp > Nanos(zero_since) + kBaseReaction && b->value.vx_mps == 0.0 &&
+         b->value.vy_mps == 0.0 && b->value.wz_radps == 0.0;
 }
 
 // ---- tracker: Amfitrack frames -> gate -> person in base_link -> human filter in odom ---------
@@ -474,6 +481,13 @@ void Daemon::control_task(const core::Tick& tick) {
   control_state_.tracking = tracking;
   const core::BodyVelocity cmd = gate_.update(allowed && tracking, requested, tick.now);
   last_command_ = core::Twist{cmd.vx_mps, cmd.vy_mps, cmd.wz_radps};
+  if (shutdown_.load(std::memory_order_acquire) && cmd.is_zero()) {
+    if (zero_commanded_since_ns_.load(std::memory_order_relaxed) == kNotYet) {
+      zero_commanded_since_ns_.store(tick.now.count(), std::memory_order_release);
+    }
+  } else {
+    zero_commanded_since_ns_.store(kNotYet, std::memory_order_release);
+  }
   control_state_.command = cmd;
   command_.publish(cmd, tick.now);
   control_status_.publish(control_state_, tick.now);
@@ -562,9 +576,6 @@ void Daemon::supervisor_task(const core::Tick& tick) {
   in.initialized = initialized_.load(std::memory_order_acquire);
   in.shutdown = shutdown_.load(std::memory_order_acquire);
   if (in.initialized && initialized_at_ == core::kNever) initialized_at_ = tick.now;
-  if (in.shutdown && shutdown_seen_at_ns_.load(std::memory_order_relaxed) == kNotYet) {
-    shutdown_seen_at_ns_.store(tick.now.count(), std::memory_order_release);
-  }
 
   if (control_stats_ != nullptr) {
     // Before the control task's first run, its heartbeat counts from start-up.

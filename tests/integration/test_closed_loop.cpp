@@ -267,3 +267,25 @@ TEST(ClosedLoop, FollowsARecordedPersonThroughARecordedCrowd) {
   EXPECT_LT(r.metrics.mean_person_distance_m, 1.6);
   EXPECT_FALSE(r.metrics.collision) << r.metrics.failure;
 }
+
+TEST(ClosedLoop, ShutdownIsNotFooledByACommandStillInTheBasesPipeline) {
+  // SIGTERM 5 ms after the robot may move: the first motion command is still inside the base's
+  // 20 ms reaction, its feedback may still read zero. Complete must wait until feedback can show
+  // them, so the base stands still from then on.
+  auto o = scenario("open");
+  o.scenario.robot_start = core::Pose2{-2.2, 0.0, 0.0};  // far from q^d: it drives off at once
+  o.duration_s = 4.0;
+  double active_at = -1;
+  double complete_at = -1;
+  bool moved_after_complete = false;
+  o.script = [&](double t, sim::SimWorld& w, firmware::Daemon& d) {
+    if (active_at < 0 && is_active(d)) active_at = t;
+    if (active_at > 0 && std::abs(t - (active_at + 0.005)) < 1e-9) d.request_shutdown();
+    if (complete_at < 0 && d.shutdown_complete()) complete_at = t;
+    if (complete_at > 0 && speed(w) != 0.0) moved_after_complete = true;
+  };
+  sim::run_simulation(o);
+  ASSERT_GT(active_at, 0);
+  ASSERT_GT(complete_at, 0);
+  EXPECT_FALSE(moved_after_complete) << "complete at " << complete_at;
+}

@@ -210,8 +210,8 @@ class Daemon {
 
   std::atomic<bool> initialized_{false};
   std::atomic<bool> shutdown_{false};
-  // When the supervisor first saw the shutdown request (monotonic ns; max until then).
-  std::atomic<int64_t> shutdown_seen_at_ns_{std::numeric_limits<int64_t>::max()};
+  // Since when the control task has commanded zero during shutdown (monotonic ns; max: not).
+  std::atomic<int64_t> zero_commanded_since_ns_{std::numeric_limits<int64_t>::max()};
 
   // supervisor task state
   core::Supervisor supervisor_;
