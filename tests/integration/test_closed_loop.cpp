@@ -289,3 +289,42 @@ TEST(ClosedLoop, ShutdownIsNotFooledByACommandStillInTheBasesPipeline) {
   ASSERT_GT(complete_at, 0);
   EXPECT_FALSE(moved_after_complete) << "complete at " << complete_at;
 }
+
+// ---- the evaluation's baselines, as configuration -------------------------------------------
+
+TEST(ClosedLoop, FixedPointBaselinesHoldTheirPointOfTheInteractiveSpace) {
+  for (const char* selector : {"fixed_behind", "fixed_side"}) {
+    auto o = scenario("open");
+    o.config.policy.selector = selector;
+    o.duration_s = 8.0;
+    int goals = 0, wrong = 0;
+    o.script = [&](double, sim::SimWorld&, firmware::Daemon& d) {
+      const auto g = d.goal().read();
+      if (!g || g->value.status != core::GoalStatus::kOk) return;
+      ++goals;
+      const int want = std::string(selector) == "fixed_behind" ? 32 : 16;  // n = 64
+      if (g->value.index != want || std::string(g->value.selector) != selector) ++wrong;
+    };
+    const auto r = sim::run_simulation(o);
+    EXPECT_GT(goals, 500) << selector;
+    EXPECT_EQ(wrong, 0) << selector;
+    EXPECT_GT(r.metrics.tracking_s, 4.0) << selector;
+  }
+}
+
+TEST(ClosedLoop, PidFollowerBaselineDrivesWithoutLateralMotion) {
+  auto o = scenario("open");
+  o.config.control.controller = "pid_follower";
+  o.duration_s = 10.0;
+  double max_vy = 0, max_vx = 0;
+  o.script = [&](double, sim::SimWorld&, firmware::Daemon& d) {
+    const auto c = d.command().read();
+    if (!c) return;
+    max_vy = std::max(max_vy, std::abs(c->value.vy_mps));
+    max_vx = std::max(max_vx, c->value.vx_mps);
+  };
+  const auto r = sim::run_simulation(o);
+  EXPECT_GT(max_vx, 0.5) << "it follows the walking person";
+  EXPECT_EQ(max_vy, 0.0) << "a differential-drive style follower";
+  EXPECT_GT(r.metrics.tracking_s, 5.0);
+}

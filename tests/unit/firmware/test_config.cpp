@@ -126,6 +126,23 @@ TEST(Config, OutOfRangeValuesAreRefused) {
                "limits.vx_max_mps", "out of range [0, 3]");
   expect_error(load_config_text("mppi:\n  samples: 0\n", "test.yaml"), 2, "mppi.samples",
                "out of range");
+  // A zero noise sigma would divide the control cost by zero: every MPPI step would fail.
+  expect_error(load_config_text("mppi:\n  noise_vx_mps: 0\n", "test.yaml"), 2, "mppi.noise_vx_mps",
+               "out of range");
+}
+
+TEST(Config, TheBaselinesAreChoices) {
+  expect_error(load_config_text("policy:\n  selector: random\n", "test.yaml"), 2, "policy.selector",
+               "not one of");
+  expect_error(load_config_text("control:\n  controller: dwa\n", "test.yaml"), 2,
+               "control.controller", "not one of");
+  const auto ok = load_config_text(
+      "policy:\n  selector: fixed_side\ncontrol:\n  controller: "
+      "pid_follower\n",
+      "test.yaml");
+  ASSERT_TRUE(ok.ok());
+  EXPECT_EQ(ok.config->policy.selector, "fixed_side");
+  EXPECT_EQ(ok.config->control.controller, "pid_follower");
 }
 
 TEST(Config, BadChoicesAreRefused) {
