@@ -374,8 +374,10 @@ int run(int argc, char** argv) {
   if (world) {
     world->stop();
     const auto& b = world->world().base().velocity();
-    spdlog::info("simulation: stopped at t={:.1f} s, base velocity {:.3f} {:.3f} {:.3f}",
-                 world->time_s(), b.vx_mps, b.vy_mps, b.wz_radps);
+    spdlog::info(
+        "simulation: stopped at t={:.1f} s, base velocity {:.3f} {:.3f} {:.3f}, world steps "
+        "late {}",
+        world->time_s(), b.vx_mps, b.vy_mps, b.wz_radps, world->overruns());
     if (!sim_opts.report_dir.empty()) {
       companiond::write_report(sim_opts.report_dir, *scenario, *world,
                                fmt::format("companiond on '{}' (real time)", scenario->name),

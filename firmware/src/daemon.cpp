@@ -149,14 +149,21 @@ core::PidFollowerConfig pid_follower_config(const DaemonConfig& cfg) {
   return c;
 }
 
-const char* side_of_person(int index, int points) {
-  if (index < 0 || points <= 0) return "-";
+int side_sector(int index, int points) {
+  if (index < 0 || points <= 0) return -1;
   // phi = 0 is ahead of the person, counter-clockwise: 90 deg is their left.
-  const int octant = (8 * index + points / 2) / points % 8;  // nearest eighth of the circle
+  return (8 * index + points / 2) / points % 8;  // nearest eighth of the circle
+}
+
+const char* side_name(int sector) {
   static constexpr std::array<const char*, 8> kSide = {"front",       "front-left", "left",
                                                        "behind-left", "behind",     "behind-right",
                                                        "right",       "front-right"};
-  return kSide[static_cast<size_t>(octant)];
+  return sector >= 0 && sector < 8 ? kSide[static_cast<size_t>(sector)] : "-";
+}
+
+const char* side_of_person(int index, int points) {
+  return side_name(side_sector(index, points));
 }
 
 namespace {
@@ -179,6 +186,10 @@ Daemon::Daemon(const DaemonConfig& cfg, hal::SystemdNotifier& notifier)
       lidar_odom_(kOdomHistory, kOdomHold),
       lidar_warning_(core::from_ms(cfg.logging.warning_interval_ms)),
       space_(interactive_space_config(cfg)),
+      selector_(cfg.policy.selector == "objective"      ? Selector::kObjective
+                : cfg.policy.selector == "fixed_behind" ? Selector::kFixedBehind
+                : cfg.policy.selector == "fixed_side"   ? Selector::kFixedSide
+                                                        : Selector::kAuto),
       mppi_(mppi_config(cfg)),
       pid_(pid_follower_config(cfg)),
       use_pid_(cfg.control.controller == "pid_follower"),
@@ -415,16 +426,16 @@ void Daemon::policy_task(const core::Tick& tick) {
                           th ? th->value.confidence : core::TrackerConfidence::kUnknown);
     space_.update(h.pose_base, robot_odom, *map);
     core::Selection s = core::select_by_objective(space_);
-    const std::string& selector = cfg_.policy.selector;
-    if (selector == "fixed_behind" || selector == "fixed_side") {
+    if (selector_ == Selector::kFixedBehind || selector_ == Selector::kFixedSide) {
       // Evaluation baselines: one point of W, free or not (phi = pi behind, pi/2 the left side).
+      const bool behind = selector_ == Selector::kFixedBehind;
       const int n = space_.config().points;
-      const int index = selector == "fixed_behind" ? n / 2 : n / 4;
+      const int index = behind ? n / 2 : n / 4;
       s.status = core::GoalStatus::kOk;
       s.index = index;
       s.goal_base = space_.candidates()[static_cast<size_t>(index)].base;
-      g.selector = selector == "fixed_behind" ? "fixed_behind" : "fixed_side";
-    } else if (policy_ && selector == "auto" && s.status == core::GoalStatus::kOk) {
+      g.selector = behind ? "fixed_behind" : "fixed_side";
+    } else if (policy_ && selector_ == Selector::kAuto && s.status == core::GoalStatus::kOk) {
       // The learned selector: the paper's observation, masked argmax over P.
       core::ObservationInputs oi;
       oi.space = &space_;

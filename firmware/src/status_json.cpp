@@ -94,6 +94,7 @@ std::string Daemon::build_status_json(core::Nanos now) const {
                     {"failures", v.failures},
                     {"repairs", v.repairs},
                     {"effective_samples", number(v.effective_samples)},
+                    {"min_cost", number(v.min_cost)},
                     {"vx_mps", number(v.command.vx_mps)},
                     {"vy_mps", number(v.command.vy_mps)},
                     {"wz_radps", number(v.command.wz_radps)}};

@@ -116,6 +116,10 @@ struct ControlStatus {
 
 // "front", "left", "behind", "right" of the person, from the design point's angle.
 const char* side_of_person(int index, int points);
+// The eighth of the circle around the person (0 front, 2 left, 4 behind, 6 right; -1 none) of
+// point `index` of n, and its name.
+int side_sector(int index, int points);
+const char* side_name(int sector);
 core::InteractiveSpaceConfig interactive_space_config(const DaemonConfig& cfg);
 core::MppiConfig mppi_config(const DaemonConfig& cfg);
 core::PidFollowerConfig pid_follower_config(const DaemonConfig& cfg);
@@ -247,6 +251,8 @@ class Daemon {
 
   // policy task state
   core::InteractiveSpace space_;
+  enum class Selector : uint8_t { kAuto, kObjective, kFixedBehind, kFixedSide };
+  Selector selector_ = Selector::kAuto;  // policy.selector, resolved once
   std::unique_ptr<core::MlpPolicy> policy_;
   std::vector<float> observation_;
   int previous_action_ = -1;

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "firmware/daemon.hpp"
+
 namespace sim {
 
 namespace {
@@ -18,10 +20,7 @@ int sector_of(double angle_rad) {
 }
 
 const char* sector_name(int sector) {
-  static constexpr std::array<const char*, 8> kNames = {"front",       "front-left", "left",
-                                                        "behind-left", "behind",     "behind-right",
-                                                        "right",       "front-right"};
-  return sector >= 0 && sector < 8 ? kNames[static_cast<size_t>(sector)] : "-";
+  return firmware::side_name(sector);
 }
 
 void RunMetricsRecorder::record(double t_s, double dt_s, const core::Pose2& robot,

@@ -47,8 +47,7 @@ DaemonView daemon_view(const firmware::Daemon& daemon, const core::Pose2& robot_
     v.has_goal = true;
     v.goal_odom = g->value.goal_odom;
     v.goal_world = robot_world * (v.robot_odom.inverse() * v.goal_odom);
-    v.side =
-        g->value.points > 0 ? (8 * g->value.index + g->value.points / 2) / g->value.points % 8 : -1;
+    v.side = firmware::side_sector(g->value.index, g->value.points);
   }
   if (const auto c = daemon.command().read()) {
     v.cmd_vx = c->value.vx_mps;
