@@ -1,7 +1,7 @@
 # Thin wrappers over CMake presets. The two commands of the README:
 #   make run    install dependencies, build, run companiond on the simulated world (SCENARIO=...)
 #   make test   install dependencies, build, run every test (ThreadSanitizer pass included)
-.PHONY: run test deps build bench fuzz format tidy clean
+.PHONY: run test deps build bench eval fuzz format tidy clean
 
 JOBS ?= $(shell nproc)
 TSAN_TARGETS := test_core_channel test_hal_clock test_firmware_executor test_firmware_daemon \
@@ -37,6 +37,13 @@ test: build
 bench: deps
 	@cmake --preset release -DCOMPANION_BUILD_BENCH=ON > /dev/null
 	@cmake --build --preset release -j $(JOBS) --target bench_core bench_scheduler bench_tracker bench_lidar bench_control
+
+# The full evaluation of docs/EVALUATION.md (sim/eval/run_benchmark.sh; ~1 h on 2 cores).
+EVAL_OUT ?= eval-full
+eval: deps
+	@cmake --preset release > /dev/null
+	@cmake --build --preset release -j $(JOBS) --target companion-eval
+	sim/eval/run_benchmark.sh $(EVAL_OUT)
 
 # Coverage-guided fuzzing of the decoders (clang + libFuzzer), FUZZ_SECONDS each, starting from
 # the seed corpora in tests/fuzz/corpus (copied: the repository is not modified).

@@ -190,6 +190,7 @@ Daemon::Daemon(const DaemonConfig& cfg, hal::SystemdNotifier& notifier)
                 : cfg.policy.selector == "fixed_behind" ? Selector::kFixedBehind
                 : cfg.policy.selector == "fixed_side"   ? Selector::kFixedSide
                                                         : Selector::kAuto),
+      goal_hold_(core::from_ms(std::llround(cfg.policy.hold_last_point_ms))),
       mppi_(mppi_config(cfg)),
       pid_(pid_follower_config(cfg)),
       use_pid_(cfg.control.controller == "pid_follower"),
@@ -362,10 +363,8 @@ void Daemon::lidar_task(const core::Tick& tick) {
   if (const auto b = base_health_.read(); b && b->value.odom_stamp != core::kNever) {
     lidar_odom_.add(b->value.odom, b->value.odom_stamp);
   }
-  std::optional<core::Point2> person;
-  if (const auto h = human_track_.read(); h && h->value.valid) {
-    person = core::Point2{h->value.mean()(0), h->value.mean()(1)};
-  }
+  std::optional<core::HumanTrack> person;
+  if (const auto h = human_track_.read(); h && h->value.valid) person = h->value;
   // A 10 Hz run drains ~75 packets (150 in dual-return mode); the bound keeps a flood from
   // stalling the task (the kernel counts what overflows).
   constexpr size_t kMaxPacketsPerRun = 1000;
@@ -461,7 +460,9 @@ void Daemon::policy_task(const core::Tick& tick) {
         }
       }
     }
-    previous_action_ = s.status == core::GoalStatus::kOk ? s.index : -1;
+    s = goal_hold_.update(s, space_, tick.now);
+    g.held = goal_hold_.held();
+    previous_action_ = goal_hold_.index();
     g.status = s.status;
     g.index = s.index;
     g.free_points = space_.free_count();

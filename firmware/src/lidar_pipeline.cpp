@@ -31,6 +31,11 @@ vlp16::ScanConfig scan_config(const DaemonConfig& cfg) {
   s.cut_azimuth = static_cast<uint16_t>(std::lround(cfg.lidar.cut_azimuth_deg * 100.0) % 36000);
   s.decode.min_range_m = static_cast<float>(cfg.lidar.min_range_m);
   s.decode.max_range_m = static_cast<float>(cfg.lidar.max_range_m);
+  // Beams without a return clear free space up to the clearing range (the voxel grid's own
+  // limit): otherwise a pedestrian's voxels stay for decay_s wherever no wall stands behind.
+  if (cfg.costmap.clear_on_no_return) {
+    s.decode.no_return_range_m = static_cast<float>(cfg.costmap.clear_max_range_m);
+  }
   return s;
 }
 
@@ -53,7 +58,7 @@ LidarPipeline::LidarPipeline(const DaemonConfig& cfg)
 const core::Costmap* LidarPipeline::add_packet(const vlp16::RawDataPacket& packet,
                                                core::Nanos host_stamp,
                                                const core::PoseHistory& odom,
-                                               std::optional<core::Point2> person) {
+                                               const std::optional<core::HumanTrack>& person) {
   const vlp16::Scan* scan = assembler_.add(packet, host_stamp);
   if (scan == nullptr) return nullptr;
   size_t n = 0;
@@ -63,7 +68,8 @@ const core::Costmap* LidarPipeline::add_packet(const vlp16::RawDataPacket& packe
     extrinsics_.apply(q);
     timed_[n++] = core::TimedPoint{q.x_m, q.y_m, q.z_m,
                                    scan->start + core::Nanos(static_cast<int64_t>(
-                                                     static_cast<double>(q.time_offset_us) * 1e3))};
+                                                     static_cast<double>(q.time_offset_us) * 1e3)),
+                                   !q.no_return};
   }
   // Without odometry (no base) the robot stands at the odom origin.
   const core::PoseHistory* poses = &odom;
@@ -82,7 +88,12 @@ const core::Costmap* LidarPipeline::add_packet(const vlp16::RawDataPacket& packe
   }
   const core::Pose2 robot = poses->at(scan->end).value_or(core::Pose2{});
   grid_.recentre(robot.x_m, robot.y_m);
-  grid_.insert(std::span(rays_.data(), d.rays), robot, person, scan->end);
+  std::optional<core::PersonSweep> sweep;
+  if (person && person->valid) {
+    sweep = core::PersonSweep{core::position_at(*person, scan->start),
+                              core::position_at(*person, scan->end)};
+  }
+  grid_.insert(std::span(rays_.data(), d.rays), robot, sweep, scan->end);
   grid_.decay(scan->end);
   costmap_.build(grid_, costmap_config_, scan->end);
   return &costmap_;

@@ -87,6 +87,52 @@ std::string csv_row(const Outcome& o, const std::string& scenario) {
       o.control_p99_ms, o.wall_s);
 }
 
+// The kind of a failure, from RunMetrics::failure ("collision with a pedestrian at t=..", "more
+// than 2 m from the person for 5 s at t=.."): what the tables count.
+std::string failure_kind(const std::string& failure) {
+  if (failure.find("an obstacle") != std::string::npos) return "hit obstacle";
+  if (failure.find("a pedestrian") != std::string::npos) return "hit pedestrian";
+  if (failure.find("the person") != std::string::npos) return "hit person";
+  return failure.rfind("more than", 0) == 0 ? "lost" : "other";
+}
+
+std::string causes_text(const std::map<std::string, int>& causes) {
+  std::string out;
+  for (const auto& [kind, count] : causes)
+    out += fmt::format("{}{} {}", out.empty() ? "" : ", ", kind, count);
+  return out.empty() ? "-" : out;
+}
+
+// The paper's crowd-density table: SR, UT and mean planning time against the number of
+// pedestrians, one row per method and density.
+std::string crowd_table(const std::vector<eval::Case>& cases,
+                        const std::vector<eval::Method>& methods,
+                        const std::vector<Outcome>& outcomes) {
+  std::string md;
+  for (const auto& m : methods) {
+    for (const auto& c : cases) {
+      if (c.name.rfind("crowd-", 0) != 0) continue;
+      int ok = 0, n = 0;
+      std::vector<double> ut, ctl;
+      for (const Outcome& o : outcomes) {
+        if (o.trial.c != &c || o.trial.method->name != m.name) continue;
+        ++n;
+        ok += o.m.success ? 1 : 0;
+        ut.push_back(o.m.uncomfortable_s);
+        ctl.insert(ctl.end(), o.control_ms.begin(), o.control_ms.end());
+      }
+      if (n == 0) continue;
+      if (md.empty()) {
+        md = "\n## crowd density\n\n| method | pedestrians | trials | SR % | UT s | mean control "
+             "step ms |\n|---|---|---|---|---|---|\n";
+      }
+      md += fmt::format("| {} | {} | {} | {:.0f} | {} | {:.2f} |\n", m.name, c.random.pedestrians,
+                        n, 100.0 * ok / n, pm(mean_std(ut), "{:.2f}"), mean_std(ctl).mean);
+    }
+  }
+  return md;
+}
+
 int run(int argc, char** argv) {
   CLI::App app{
       "companion-eval: the paper's tables from the simulated world (reference/evaluation.md)"};
@@ -246,15 +292,17 @@ int run(int argc, char** argv) {
                       c.trials == 1 ? "" : "s");
     md +=
         "| method | SR % | UT s | e_x m | e_y m | e_θ rad | in ellipse s | min dist. person m | "
-        "collisions | policy p50 / p99 ms | control p50 / p99 ms |\n"
-        "|---|---|---|---|---|---|---|---|---|---|---|\n";
+        "collisions | failures | policy p50 / p99 ms | control p50 / p99 ms |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& m : methods) {
       std::vector<double> ut, ex, ey, et, ell, dmin, ctl, pol;
       int ok = 0, n = 0, collisions = 0;
+      std::map<std::string, int> causes;  // the first failure of each failed trial
       for (const Outcome& o : outcomes) {
         if (o.trial.c != &c || o.trial.method->name != m.name) continue;
         ++n;
         ok += o.m.success ? 1 : 0;
+        if (!o.m.success) ++causes[failure_kind(o.m.failure)];
         collisions += o.m.collision ? 1 : 0;
         ut.push_back(o.m.uncomfortable_s);
         ex.push_back(o.m.rmse_ex_m);
@@ -267,14 +315,15 @@ int run(int argc, char** argv) {
       }
       if (n == 0) continue;
       md += fmt::format(
-          "| {} | {:.0f} | {} | {} | {} | {} | {} | {} | {} | {:.3f} / {:.3f} | {:.3f} / {:.3f} "
-          "|\n",
+          "| {} | {:.0f} | {} | {} | {} | {} | {} | {} | {} | {} | {:.3f} / {:.3f} | {:.3f} / "
+          "{:.3f} |\n",
           m.name, 100.0 * ok / n, pm(mean_std(ut), "{:.2f}"), pm(mean_std(ex), "{:.3f}"),
           pm(mean_std(ey), "{:.3f}"), pm(mean_std(et), "{:.3f}"), pm(mean_std(ell), "{:.2f}"),
-          pm(mean_std(dmin), "{:.2f}"), collisions, sim::quantile(pol, 0.5),
+          pm(mean_std(dmin), "{:.2f}"), collisions, causes_text(causes), sim::quantile(pol, 0.5),
           sim::quantile(pol, 0.99), sim::quantile(ctl, 0.5), sim::quantile(ctl, 0.99));
     }
   }
+  md += crowd_table(cases, methods, outcomes);
   std::ofstream(out_dir + "/summary.md") << md;
   std::cout << "\n"
             << md << fmt::format("\nwrote {}/trials.csv and {}/summary.md\n", out_dir, out_dir);

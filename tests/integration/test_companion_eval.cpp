@@ -51,6 +51,30 @@ TEST(CompanionEval, RunsCasesAndMethodsByNameAndWritesTablesCsvAndPlots) {
   }
 }
 
+TEST(CompanionEval, TheOneCommandBenchmarkWritesEveryTableAndPlot) {
+  // sim/eval/run_benchmark.sh, reduced: 1 trial per random case, one method, 2 s trials.
+  const std::string out = ::testing::TempDir() + "companion-benchmark-ci";
+  ChildProcess p({"/usr/bin/env", "EVAL=" COMPANION_EVAL_PATH, "TRIALS=1", "VARIANT_TRIALS=1",
+                  "METHODS=objective", "DURATION_S=2", "JOBS=2", "bash", COMPANION_BENCHMARK_SCRIPT,
+                  out});
+  ASSERT_TRUE(p.started());
+  ASSERT_EQ(p.wait(900s), 0) << p.output();
+  const std::string report = slurp(out + "/REPORT.md");
+  for (const char* expected :
+       {"trials/min", "# paper", "## open (1 trial per method)", "## random (1 trial per method)",
+        "# variants", "## crowd-20 (1 trial per method)", "## speed-1.7 (1 trial per method)",
+        "## size-1.2x0.9 (1 trial per method)", "## crowd density", "| objective | 15 | 1 |",
+        "# recorded-biwi_hotel", "# recorded-crowds_zara01", "| failures |"}) {
+    EXPECT_NE(report.find(expected), std::string::npos) << expected << "\n" << report;
+  }
+  // 7 paper cases + 10 variants + 2 recorded.
+  EXPECT_NE(report.find("19 trials in"), std::string::npos) << report;
+  for (const char* f : {"/paper/plots/sides-random.png", "/paper/plots/trajectories-doorway.png",
+                        "/recorded-biwi_hotel/plots/trajectories-recorded.png"}) {
+    EXPECT_GT(slurp(out + f).size(), 1000U) << f;
+  }
+}
+
 TEST(CompanionEval, FollowsARecordedPersonFromAnyDatasetFile) {
   const std::string out = ::testing::TempDir() + "companion-eval-recorded";
   ChildProcess p({COMPANION_EVAL_PATH, "--pedestrians", COMPANION_PEDESTRIANS "/biwi_hotel.txt",

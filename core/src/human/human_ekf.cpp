@@ -103,6 +103,11 @@ void predict_path(const HumanTrack& track, Nanos t0, double dt_s, std::span<Pose
   }
 }
 
+Point2 position_at(const HumanTrack& track, Nanos t) {
+  const double dt = to_seconds(t - track.stamp);
+  return Point2{track.mean()(0) + track.mean()(3) * dt, track.mean()(1) + track.mean()(4) * dt};
+}
+
 HumanEkf::HumanEkf(const HumanEkfConfig& config) : config_(config) {}
 
 void HumanEkf::predict_to(Nanos t) {

@@ -28,8 +28,8 @@ DeskewResult deskew(std::span<const TimedPoint> in, const PoseHistory& odom,
       ++r.no_pose;
       continue;
     }
-    out[r.rays++] =
-        Ray{origin, Point3{pose->x_m + c * p.x - s * p.y, pose->y_m + s * p.x + c * p.y, p.z}};
+    out[r.rays++] = Ray{
+        origin, Point3{pose->x_m + c * p.x - s * p.y, pose->y_m + s * p.x + c * p.y, p.z}, p.hit};
   }
   return r;
 }

@@ -221,8 +221,8 @@ void VoxelGrid::clear_ray(const Ray& r, int64_t end_cx, int64_t end_cy, int end_
   }
 }
 
-void VoxelGrid::insert(std::span<const Ray> rays, const Pose2& robot, std::optional<Point2> person,
-                       Nanos now) {
+void VoxelGrid::insert(std::span<const Ray> rays, const Pose2& robot,
+                       std::optional<PersonSweep> person, Nanos now) {
   // Clear with every ray first, then mark: a grazing ray of this scan must not erase a return
   // of the same scan.
   ++scan_serial_;
@@ -250,13 +250,18 @@ void VoxelGrid::insert(std::span<const Ray> rays, const Pose2& robot, std::optio
     }
     if (seen) continue;
     ++stats_.rays_traced;
-    clear_ray(r, cx, cy, cz);
+    // A beam without a return keeps nothing at its end: it clears the whole way.
+    clear_ray(r, cx, cy, r.hit ? cz : -1);
   }
   const Pose2 odom_to_base = robot.inverse();
   const uint16_t stamp = stamp_units(now);
   const double r2 = cfg_.person_mask_radius_m * cfg_.person_mask_radius_m;
   for (const Ray& r : rays) {
     ++stats_.rays;
+    if (!r.hit) {
+      ++stats_.no_return;
+      continue;
+    }
     if (r.end.z < cfg_.z_min_m || r.end.z >= cfg_.z_min_m + nz_ * res_) {
       ++stats_.out_of_band;
       continue;
@@ -268,8 +273,17 @@ void VoxelGrid::insert(std::span<const Ray> rays, const Pose2& robot, std::optio
       continue;
     }
     if (person) {
-      const double ex = r.end.x - person->x_m;
-      const double ey = r.end.y - person->y_m;
+      // Distance to the segment the person swept during the scan.
+      const double sx = person->to.x_m - person->from.x_m;
+      const double sy = person->to.y_m - person->from.y_m;
+      const double len2 = sx * sx + sy * sy;
+      double ex = r.end.x - person->from.x_m;
+      double ey = r.end.y - person->from.y_m;
+      if (len2 > 1e-12) {
+        const double u = std::clamp((ex * sx + ey * sy) / len2, 0.0, 1.0);
+        ex -= u * sx;
+        ey -= u * sy;
+      }
       if (ex * ex + ey * ey <= r2) {
         ++stats_.person_masked;
         continue;

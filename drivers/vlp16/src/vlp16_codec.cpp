@@ -227,7 +227,8 @@ size_t decode_points(const RawDataPacket& p, const DecodeOptions& options, std::
     const bool is_last = dual ? (b % 2 == 0) : p.mode == ReturnMode::kLast;
     for (size_t k = 0; k < kChannels; ++k) {
       const uint16_t d = blk.distance[k];
-      if (d == 0 || d < min_units || d > max_units) continue;
+      const bool no_return = d == 0 && options.no_return_range_m > 0.0f;
+      if (!no_return && (d == 0 || d < min_units || d > max_units)) continue;
       // Dual: the strongest block repeats the last block's return when there was only one.
       if (dual && b % 2 == 1 && p.blocks[b - 1].distance[k] == d &&
           p.blocks[b - 1].intensity[k] == blk.intensity[k]) {
@@ -240,7 +241,8 @@ size_t decode_points(const RawDataPacket& p, const DecodeOptions& options, std::
           kLaserSpacingUs * static_cast<double>(laser) + kSequenceUs * static_cast<double>(firing);
       const auto az = static_cast<uint32_t>(
           (blk.azimuth + static_cast<uint32_t>(std::lround(gap * dt / kBlockUs))) % kAzimuthUnits);
-      const float r = static_cast<float>(d) * static_cast<float>(kDistanceUnitM);
+      const float r = no_return ? options.no_return_range_m
+                                : static_cast<float>(d) * static_cast<float>(kDistanceUnitM);
       const float xy = r * lt.cos_elevation[laser];
       Point& pt = out[n++];
       pt.x_m = xy * at.cos_az[az];
@@ -254,6 +256,7 @@ size_t decode_points(const RawDataPacket& p, const DecodeOptions& options, std::
       pt.block = static_cast<uint8_t>(b);
       pt.channel = static_cast<uint8_t>(k);
       pt.last_return = is_last;
+      pt.no_return = no_return;
       pt.time_offset_us = static_cast<float>(kSequenceUs * static_cast<double>(seq_base + firing) +
                                              kLaserSpacingUs * static_cast<double>(laser));
     }

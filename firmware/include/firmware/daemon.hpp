@@ -19,6 +19,7 @@
 #include "core/geometry/pose_history.hpp"
 #include "core/human/human_ekf.hpp"
 #include "core/perception/costmap.hpp"
+#include "core/planner/goal_hold.hpp"
 #include "core/planner/interactive_space.hpp"
 #include "core/policy/mlp_policy.hpp"
 #include "core/policy/observation.hpp"
@@ -100,6 +101,7 @@ struct CompanionGoal {
   core::Pose2 person_odom;  // the person when q^d was chosen (q^d moves with them)
   // Static text: "objective", "policy", "fixed_behind", "fixed_side" (policy.selector).
   const char* selector = "objective";
+  bool held = false;  // no free point: the last choice kept (policy.hold_last_point_ms)
 };
 // What the control task publishes: how the controller did on its latest run.
 struct ControlStatus {
@@ -256,6 +258,7 @@ class Daemon {
   std::unique_ptr<core::MlpPolicy> policy_;
   std::vector<float> observation_;
   int previous_action_ = -1;
+  core::GoalHold goal_hold_;  // policy.hold_last_point_ms
   core::LatestValue<CompanionGoal> goal_;
 
   // base (driver owned by the realtime group's thread: base and control tasks)

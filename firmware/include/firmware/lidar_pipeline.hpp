@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/geometry/pose_history.hpp"
+#include "core/human/human_ekf.hpp"
 #include "core/perception/costmap.hpp"
 #include "core/perception/deskew.hpp"
 #include "core/perception/voxel_grid.hpp"
@@ -35,10 +36,11 @@ class LidarPipeline {
 
   // One decoded packet. When it completes a scan, the scan is processed and the new costmap is
   // returned (valid until the next one); otherwise nullptr. `odom` holds base poses in odom
-  // (empty: the robot stands at the odom origin); `person` is the tracked person in odom.
+  // (empty: the robot stands at the odom origin); `person` is the tracked person (odom), whose
+  // returns are masked where the track puts them over the scan's time.
   const core::Costmap* add_packet(const vlp16::RawDataPacket& packet, core::Nanos host_stamp,
                                   const core::PoseHistory& odom,
-                                  std::optional<core::Point2> person);
+                                  const std::optional<core::HumanTrack>& person);
 
   [[nodiscard]] const vlp16::ScanAssembler& assembler() const { return assembler_; }
   [[nodiscard]] const core::VoxelGrid& grid() const { return grid_; }

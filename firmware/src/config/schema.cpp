@@ -139,6 +139,16 @@ std::vector<FieldSpec> build() {
        0.5,
        100.0,
        {}},
+      {"costmap.clear_on_no_return",
+       "bool",
+       "Beams without a return clear free space up to clear_max_range_m (as the "
+       "spatio-temporal voxel layer's frustum clearing does). Without it a pedestrian's "
+       "voxels stay for decay_s wherever nothing stands behind them. A surface that returns "
+       "nothing (black, glass) is then free space: keep decay_s for those.",
+       FIELD(costmap.clear_on_no_return),
+       0,
+       0,
+       {}},
       {"costmap.inscribed_radius_m",
        "m",
        "Robot's inscribed radius: cells closer than this to an obstacle are lethal (100).",
@@ -612,6 +622,16 @@ std::vector<FieldSpec> build() {
        0,
        0,
        {"auto", "objective", "fixed_behind", "fixed_side"}},
+      {"policy.hold_last_point_ms",
+       "ms",
+       "When no point of W is free (a pedestrian passing close to the person closes them all), "
+       "keep tracking the last chosen point, moved with the person, for this long before the "
+       "robot stops for want of a goal; the controller's collision cost still keeps it off what "
+       "closed the points. 0: stop at once.",
+       FIELD(policy.hold_last_point_ms),
+       0,
+       10000,
+       {}},
       {"control.controller",
        "name",
        "mppi_cbf: the paper's controller (MPPI with the DCBF cost, QP repair). pid_follower: the "

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "firmware/daemon.hpp"
@@ -38,8 +39,16 @@ void RunMetricsRecorder::record(double t_s, double dt_s, const core::Pose2& robo
     m_.collision_t_s = t_s;
     if (m_.success) {
       m_.success = false;
-      m_.failure = fmt::format("collision with {} at t={:.1f} s",
-                               static_clearance_m <= 0 ? "an obstacle" : "a person", t_s);
+      // Which person: the nearer centre (the clearances do not say).
+      double nearest_pedestrian_m = std::numeric_limits<double>::infinity();
+      for (const core::Point2& p : pedestrians) {
+        nearest_pedestrian_m =
+            std::min(nearest_pedestrian_m, std::hypot(robot.x_m - p.x_m, robot.y_m - p.y_m));
+      }
+      const char* what = static_clearance_m <= 0     ? "an obstacle"
+                         : d <= nearest_pedestrian_m ? "the person"
+                                                     : "a pedestrian";
+      m_.failure = fmt::format("collision with {} at t={:.1f} s", what, t_s);
     }
   }
   // Lost: > 2 m from the person for > 5 s.

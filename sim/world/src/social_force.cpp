@@ -81,12 +81,13 @@ void Crowd::step(double dt_s, const StaticWorld& world, std::span<const MovingBo
   accel_.assign(people_.size(), Point2{});
   for (size_t i = 0; i < people_.size(); ++i) {
     Pedestrian& p = people_[i];
-    while (!p.arrived()) {
+    // Past the goals already reached; at most one lap: a looping walker whose goals all lie within
+    // goal_radius of where they stand would otherwise spin here for ever.
+    for (size_t checked = 0; !p.arrived() && checked < p.goals.size(); ++checked) {
       const Point2& g = p.goals[p.next_goal];
       if (std::hypot(g.x_m - p.position.x_m, g.y_m - p.position.y_m) > params_.goal_radius_m) break;
       ++p.next_goal;
       if (p.arrived() && p.loop) p.next_goal = 0;
-      if (p.goals.size() == 1 && p.loop) break;
     }
     Point2 dir{0, 0};
     double speed = 0;

@@ -224,6 +224,10 @@ TEST(HumanEkf, PredictsToQueryTimesAndIntoTheRobotFrame) {
   EXPECT_NEAR(path[2].x_m, 1.7, 1e-12);
   EXPECT_NEAR(path[2].y_m, 2.35, 1e-12);
   EXPECT_NEAR(path[2].theta_rad, 0.07, 1e-12);
+  // Positions before the track's stamp too (where the person was during an older lidar scan).
+  const core::Point2 earlier = core::position_at(track, 800ms);
+  EXPECT_NEAR(earlier.x_m, 0.8, 1e-12);
+  EXPECT_NEAR(earlier.y_m, 1.9, 1e-12);
 
   const core::HumanEkfConfig cfg;
   const Pose2 base_in_odom{1.0, 0.0, std::numbers::pi / 2};  // robot at (1, 0) facing +y

@@ -6,6 +6,7 @@
 
 #include "core/perception/costmap.hpp"
 #include "core/perception/voxel_grid.hpp"
+#include "core/planner/goal_hold.hpp"
 #include "core/planner/interactive_space.hpp"
 
 using std::numbers::pi;
@@ -85,26 +86,78 @@ TEST(InteractiveSpace, PExcludesPointsInObstaclesAndArgminPicksTheOpenSide) {
   EXPECT_EQ(open.free_count(), 64U);
 }
 
-TEST(InteractiveSpace, ASurroundedPersonGivesNoGoalWithAReason) {
-  core::InteractiveSpace w(core::InteractiveSpaceConfig{});
-  // A ring of obstacles 0.9 m around the person (a crowd): every ellipse point is too close.
+// A ring of obstacles 0.9 m around (cx, 0) (a crowd): every ellipse point there is too close.
+core::Costmap ring_around(double cx) {
   core::VoxelGridConfig gc;
   gc.size_xy_m = 8.0;
   core::VoxelGrid g(gc);
   g.recentre(0, 0);
   std::vector<core::Ray> rays;
   for (double a = 0; a < 2 * pi; a += 0.01) {
-    rays.push_back({{2.0, 0.0, 3.0}, {2.0 + 0.9 * std::cos(a), 0.9 * std::sin(a), 0.5}});
+    rays.push_back({{cx, 0.0, 3.0}, {cx + 0.9 * std::cos(a), 0.9 * std::sin(a), 0.5}});
   }
   g.insert(rays, core::Pose2{-20, -20, 0}, std::nullopt, 1s);
   core::Costmap m;
   m.build(g, core::CostmapConfig{}, 1s);
-  w.update(core::Pose2{2.0, 0.0, 0.0}, core::Pose2{}, m);
+  return m;
+}
+
+TEST(InteractiveSpace, ASurroundedPersonGivesNoGoalWithAReason) {
+  core::InteractiveSpace w(core::InteractiveSpaceConfig{});
+  w.update(core::Pose2{2.0, 0.0, 0.0}, core::Pose2{}, ring_around(2.0));
   EXPECT_EQ(w.free_count(), 0U);
   const auto s = core::select_by_objective(w);
   EXPECT_EQ(s.status, core::GoalStatus::kNoFreePoint);
   EXPECT_EQ(s.index, -1);
   EXPECT_EQ(core::to_string(s.status), "no free point around the person");
+}
+
+TEST(GoalHold, KeepsTheLastPointThroughAMomentWithoutAFreeOneThenLetsGo) {
+  core::InteractiveSpace w(core::InteractiveSpaceConfig{});
+  core::GoalHold hold(1500ms);
+  // Open: the objective chooses a point, and it passes through.
+  w.update(core::Pose2{2.0, 0.0, 0.0}, core::Pose2{}, room(std::nullopt));
+  const core::Selection free = core::select_by_objective(w);
+  ASSERT_EQ(free.status, core::GoalStatus::kOk);
+  core::Selection s = hold.update(free, w, 10s);
+  EXPECT_EQ(s.index, free.index);
+  EXPECT_FALSE(hold.held());
+  // The person, now 0.5 m further on, is closed in (a pedestrian passing): the same point of W,
+  // moved with them, for 1.5 s.
+  w.update(core::Pose2{2.5, 0.0, 0.0}, core::Pose2{}, ring_around(2.5));
+  const core::Selection none = core::select_by_objective(w);
+  ASSERT_EQ(none.status, core::GoalStatus::kNoFreePoint);
+  s = hold.update(none, w, 11s);
+  EXPECT_TRUE(hold.held());
+  EXPECT_EQ(s.status, core::GoalStatus::kOk);
+  EXPECT_EQ(s.index, free.index);
+  EXPECT_NEAR(s.goal_base.x_m, free.goal_base.x_m + 0.5, 1e-9) << "it moves with the person";
+  EXPECT_NEAR(s.goal_base.y_m, free.goal_base.y_m, 1e-9);
+  s = hold.update(none, w, 11500ms);
+  EXPECT_TRUE(hold.held());
+  // Past the hold: no goal (the robot stops), and no memory of the old point afterwards.
+  s = hold.update(none, w, 11501ms);
+  EXPECT_FALSE(hold.held());
+  EXPECT_EQ(s.status, core::GoalStatus::kNoFreePoint);
+  EXPECT_EQ(hold.index(), -1);
+  s = hold.update(none, w, 11502ms);
+  EXPECT_FALSE(hold.held());
+}
+
+TEST(GoalHold, NeverHoldsWithoutAPersonOrWithAZeroHold) {
+  core::InteractiveSpace w(core::InteractiveSpaceConfig{});
+  w.update(core::Pose2{2.0, 0.0, 0.0}, core::Pose2{}, room(std::nullopt));
+  const core::Selection free = core::select_by_objective(w);
+  core::GoalHold hold(1500ms);
+  hold.update(free, w, 1s);
+  core::Selection lost;  // kNoPerson: the track is gone, nothing to move the point with
+  EXPECT_EQ(hold.update(lost, w, 1100ms).status, core::GoalStatus::kNoPerson);
+  EXPECT_FALSE(hold.held());
+  core::GoalHold none(0ms);
+  none.update(free, w, 1s);
+  w.update(core::Pose2{2.0, 0.0, 0.0}, core::Pose2{}, ring_around(2.0));
+  EXPECT_EQ(none.update(core::select_by_objective(w), w, 1010ms).status,
+            core::GoalStatus::kNoFreePoint);
 }
 
 }  // namespace

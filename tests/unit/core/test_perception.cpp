@@ -94,7 +94,7 @@ TEST(VoxelGrid, SelfFilterAndPersonMask) {
   core::VoxelGrid g(small_grid());
   g.recentre(5, 5);
   const core::Pose2 robot{5.0, 5.0, M_PI / 2};  // facing +y in odom
-  const core::Point2 person{5.0, 6.2};
+  const core::PersonSweep person{{5.0, 6.2}, {5.0, 6.2}};
   g.insert(std::vector<Ray>{ray_to(5.2, 5.0, 0.3, Point3{5, 5, 0.5}),   // on the robot's body
                             ray_to(5.1, 6.3, 1.0, Point3{5, 5, 0.5}),   // on the person
                             ray_to(7.0, 5.0, 0.5, Point3{5, 5, 0.5})},  // an obstacle
@@ -103,6 +103,42 @@ TEST(VoxelGrid, SelfFilterAndPersonMask) {
   EXPECT_EQ(g.stats().person_masked, 1U);
   EXPECT_EQ(g.occupied_count(), 1U);
   EXPECT_TRUE(g.occupied(7.0, 5.0, 0.5));
+}
+
+TEST(VoxelGrid, PersonMaskCoversWhereThePersonWalkedDuringTheScan) {
+  // The person walked from (5, 6) to (5, 6.6) while the scan was taken (a fast walker and a
+  // track newer than the scan). Their back at the scan's start (5, 5.75) is 0.85 m from where the
+  // track puts them now: a mask around that one position would mark it.
+  core::VoxelGrid g(small_grid());
+  g.recentre(5, 5);
+  const core::Pose2 robot{3.0, 3.0, 0.0};
+  const core::Point3 origin{3, 3, 0.5};
+  g.insert(std::vector<Ray>{ray_to(5.0, 5.75, 1.0, origin),  // their back, at the start
+                            ray_to(5.2, 6.3, 1.0, origin),   // their side, half way
+                            ray_to(5.0, 6.85, 1.0, origin),  // their front, at the end
+                            ray_to(5.0, 7.2, 1.0, origin)},  // 0.6 m ahead of them: not them
+           robot, core::PersonSweep{{5.0, 6.0}, {5.0, 6.6}}, 1s);
+  EXPECT_EQ(g.stats().person_masked, 3U);
+  EXPECT_EQ(g.occupied_count(), 1U);
+  EXPECT_TRUE(g.occupied(5.0, 7.2, 1.0));
+}
+
+TEST(VoxelGrid, BeamsWithoutAReturnClearTheWholeWayAndMarkNothing) {
+  // A pedestrian stood at (7, 5); they walked on and nothing stands behind that place: the beam
+  // that hit them now returns nothing. Its no-return ray must clear their voxel (otherwise it
+  // stays for decay_s), and mark nothing at its own end.
+  core::VoxelGrid g(small_grid());
+  g.recentre(5, 5);
+  const Point3 origin{5, 5, 0.5};
+  g.insert(std::vector<Ray>{ray_to(7.0, 5.0, 0.5, origin)}, core::Pose2{5, 5, 0}, std::nullopt, 1s);
+  ASSERT_TRUE(g.occupied(7.0, 5.0, 0.5));
+  Ray nothing = ray_to(8.5, 5.0, 0.5, origin);
+  nothing.hit = false;
+  g.insert(std::vector<Ray>{nothing}, core::Pose2{5, 5, 0}, std::nullopt, 1100ms);
+  EXPECT_FALSE(g.occupied(7.0, 5.0, 0.5));
+  EXPECT_FALSE(g.occupied(8.5, 5.0, 0.5)) << "the end of a no-return ray is not an obstacle";
+  EXPECT_EQ(g.occupied_count(), 0U);
+  EXPECT_EQ(g.stats().no_return, 1U);
 }
 
 TEST(VoxelGrid, WindowRollsWithTheRobotWithoutMovingObstacles) {

@@ -236,6 +236,34 @@ TEST(Vlp16, DualReturnDoesNotDuplicateCoincidingReturnsAndTimesFiringPairs) {
   EXPECT_EQ(vlp16::block_azimuth_gap(p, 11), 40) << "the last pair reuses the previous gap";
 }
 
+TEST(Vlp16, BeamsWithoutAReturnArePointsAlongTheBeamOnlyWhenAsked) {
+  auto p = synthetic(vlp16::ReturnMode::kStrongest, 1000, 9000, 3);
+  p.blocks[0].distance[1] = 0;  // laser 1 (+1 degree) of the first firing saw nothing
+  std::array<vlp16::Point, vlp16::kReturnsPerPacket> pts;
+  vlp16::DecodeOptions skip;
+  const size_t n_skip = vlp16::decode_points(p, skip, pts);
+  for (size_t i = 0; i < n_skip; ++i) {
+    EXPECT_FALSE(pts[i].no_return);
+    EXPECT_FALSE(pts[i].block == 0 && pts[i].channel == 1) << "skipped by default";
+  }
+  vlp16::DecodeOptions clear = skip;
+  clear.no_return_range_m = 8.0f;
+  const size_t n_clear = vlp16::decode_points(p, clear, pts);
+  ASSERT_EQ(n_clear, n_skip + 1);
+  int flagged = 0;
+  for (size_t i = 0; i < n_clear; ++i) {
+    if (!pts[i].no_return) continue;
+    ++flagged;
+    EXPECT_EQ(pts[i].block, 0);
+    EXPECT_EQ(pts[i].channel, 1);
+    EXPECT_FLOAT_EQ(pts[i].distance_m, 8.0f);
+    // 8 m along the +1 degree beam: 0.14 m up (plus the laser's vertical offset), ~0 m east.
+    EXPECT_NEAR(std::hypot(pts[i].x_m, pts[i].y_m), 8.0 * std::cos(M_PI / 180.0), 1e-3);
+    EXPECT_NEAR(pts[i].z_m, 8.0 * std::sin(M_PI / 180.0), 0.02);
+  }
+  EXPECT_EQ(flagged, 1);
+}
+
 TEST(Vlp16, MalformedPacketsAreRejectedForTheirReason) {
   const auto good = vlp16::encode_data_packet(synthetic(vlp16::ReturnMode::kStrongest, 5, 0, 1));
   vlp16::RawDataPacket out;

@@ -189,6 +189,22 @@ TEST(SocialForce, WallsRepelAndForcesFromBehindCountHalf) {
   EXPECT_NEAR(-fa.x_m, 2.1 / 0.3 * std::exp(-1.0 / 0.3), 1e-4);
 }
 
+TEST(SocialForce, ALoopingWalkerWhoseGoalsAreAllWhereTheyStandDoesNotHangTheStep) {
+  // The random scenario's walkers go to a random point and back, for ever; when that point falls
+  // within goal_radius of the start, both goals are "reached" where they stand. The step used to
+  // cycle through them for ever (a whole benchmark hung on one such seed).
+  sim::Crowd crowd;
+  sim::Pedestrian p;
+  p.position = {1, 1};
+  p.goals = {{1.05, 1.0}, {1, 1}};
+  p.loop = true;
+  crowd.add(p);
+  for (int i = 0; i < 100; ++i)
+    crowd.step(0.01, sim::StaticWorld{}, {});
+  EXPECT_LT(std::hypot(crowd.people()[0].position.x_m - 1, crowd.people()[0].position.y_m - 1), 0.3)
+      << "they stay about where they are";
+}
+
 TEST(SocialForce, SpeedIsCappedAt1_3TimesTheDesired) {
   sim::Crowd crowd;
   sim::Pedestrian p;
@@ -376,6 +392,16 @@ TEST(RunMetrics, UncomfortableTimeFarFailureAndCollision) {
   EXPECT_TRUE(m.collision);
   EXPECT_FALSE(m.success);
   EXPECT_NE(m.failure.find("obstacle"), std::string::npos);
+
+  // Touching people: the nearer centre names who (the tables count the kinds).
+  sim::RunMetricsRecorder pedestrian;
+  pedestrian.record(0.0, 0.01, Pose2{-1, 0, 0}, person, {{-1.0, 0.5}}, 5.0, 0.0, v);
+  EXPECT_NE(pedestrian.finish().failure.find("collision with a pedestrian"), std::string::npos)
+      << pedestrian.finish().failure;
+  sim::RunMetricsRecorder same;
+  same.record(0.0, 0.01, Pose2{-0.5, 0, 0}, person, {{-1.5, 1.0}}, 5.0, 0.0, v);
+  EXPECT_NE(same.finish().failure.find("collision with the person"), std::string::npos)
+      << same.finish().failure;
 }
 
 TEST(RunMetrics, TrackingErrorIsInTheRobotFrame) {

@@ -96,6 +96,8 @@ HumanTrack predict_track(const HumanTrack& track, Nanos t, const HumanEkfConfig&
 
 // Constant-velocity prediction of the person's pose at t0, t0 + dt, ... (out.size() poses).
 void predict_path(const HumanTrack& track, Nanos t0, double dt_s, std::span<Pose2> out);
+// The person's position at t (before or after the track's stamp), constant velocity.
+Point2 position_at(const HumanTrack& track, Nanos t);
 
 // What the planner and the controller consume.
 struct HumanState {

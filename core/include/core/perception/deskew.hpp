@@ -12,6 +12,7 @@ namespace core {
 struct TimedPoint {
   double x = 0, y = 0, z = 0;  // base_link at the return's time
   Nanos stamp{0};
+  bool hit = true;  // false: the beam saw nothing up to here (clears, never marks)
 };
 
 struct DeskewResult {

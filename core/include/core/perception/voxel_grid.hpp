@@ -32,7 +32,8 @@ struct VoxelGridConfig {
   // Self filter: the robot's body in base_link (returns inside are not obstacles).
   double footprint_x_min_m = -0.35, footprint_x_max_m = 0.35;
   double footprint_y_min_m = -0.30, footprint_y_max_m = 0.30;
-  double person_mask_radius_m = 0.45;  // returns this close to the tracked person: not marked
+  double person_mask_radius_m =
+      0.45;  // returns this close to the tracked person's sweep: not marked
 };
 
 struct Point3 {
@@ -42,6 +43,9 @@ struct Point3 {
 struct Ray {
   Point3 origin;  // sensor origin at the return's time (odom)
   Point3 end;     // the return (odom)
+  // false: no return; `end` is a point on the beam up to which it crossed free space. The ray
+  // clears up to there and marks nothing.
+  bool hit = true;
 };
 
 struct VoxelGridStats {
@@ -52,8 +56,18 @@ struct VoxelGridStats {
   uint64_t out_of_band = 0;    // ground / overhead
   uint64_t out_of_window = 0;  // end point outside the window (the ray still clears)
   uint64_t cleared = 0;        // voxels freed by rays
+  uint64_t no_return = 0;      // rays of beams without a return (clear only)
   uint64_t rays_traced = 0;    // rays cast for clearing (one per end voxel and scan)
   uint64_t decayed = 0;        // voxels freed by age
+};
+
+// Where the tracked person was while the scan was taken (odom): from the scan's first return to
+// its last. A walking person moves up to 0.15 m in one revolution, and the newest track can be
+// 100 ms younger than the scan: masking around one position leaves the person's back unmasked,
+// and those returns, marked and inflated, would close the interactive space behind them.
+struct PersonSweep {
+  Point2 from;
+  Point2 to;
 };
 
 class VoxelGrid {
@@ -63,8 +77,9 @@ class VoxelGrid {
   // Centres the window on the robot (odom). Cells that leave the window are emptied.
   void recentre(double robot_x_m, double robot_y_m);
   // Marks and clears with one scan's rays. `robot` is the base pose in odom for the self filter
-  // (the scan is short: one pose is accurate to a few cm), `person` the tracked person (odom).
-  void insert(std::span<const Ray> rays, const Pose2& robot, std::optional<Point2> person,
+  // (the scan is short: one pose is accurate to a few cm), `person` the tracked person (odom):
+  // returns within person_mask_radius_m of the swept segment are not marked.
+  void insert(std::span<const Ray> rays, const Pose2& robot, std::optional<PersonSweep> person,
               Nanos now);
   // Frees voxels older than decay_s.
   void decay(Nanos now);

@@ -92,12 +92,17 @@ struct Point {
   uint8_t block = 0;         // 0..11
   uint8_t channel = 0;       // 0..31
   bool last_return = false;  // dual mode: from the "last" block (else strongest)
+  bool no_return = false;    // the beam saw nothing: a point at no_return_range_m along it
   float time_offset_us = 0;  // after the packet timestamp
 };
 
 struct DecodeOptions {
   float min_range_m = 0.3f;  // closer returns are the sensor's housing / noise: dropped
   float max_range_m = 130.0f;
+  // > 0: a channel without a return (distance 0) still yields a point this far along its beam,
+  // flagged no_return: the beam crossed free space up to there (what clears where a pedestrian
+  // was when nothing stands behind them). 0: channels without a return are skipped.
+  float no_return_range_m = 0.0f;
 };
 
 // Returns of one packet into `out` (capacity >= kReturnsPerPacket); returns the count written.

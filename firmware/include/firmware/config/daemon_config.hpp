@@ -46,6 +46,7 @@ struct DaemonConfig {
     double z_max_m = 0;
     double decay_s = 0;
     double clear_max_range_m = 0;
+    bool clear_on_no_return = false;
     double inscribed_radius_m = 0;
     double inflation_radius_m = 0;
     double cost_scaling_per_m = 0;
@@ -116,6 +117,7 @@ struct DaemonConfig {
   struct Policy {
     std::string file;      // empty: the objective argmin selects
     std::string selector;  // auto, objective, fixed_behind, fixed_side
+    double hold_last_point_ms = 0;
   } policy;
 
   struct Control {

@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# The full evaluation of docs/EVALUATION.md, in one command: scenarios 1-6, the 50-trial random
+# benchmark (scenario 7), crowd densities 5/10/15/20, walking speeds 0.75/1.2/1.7 m/s, three
+# interaction-space sizes and both recorded-pedestrian files, for every method; then the plots
+# and one report (OUT/REPORT.md: every table, the wall time, trials per minute).
+#
+#   sim/eval/run_benchmark.sh [OUT]          (default: eval-full; ~70 min on 2 cores)
+#
+# Environment: EVAL (the companion-eval binary, default build/release/sim/companion-eval),
+# TRIALS (random trials of scenario 7, default 50), VARIANT_TRIALS (per crowd/speed/size case,
+# default 10), METHODS (default objective,fixed_behind,fixed_side,pid; add policy with a policy
+# file in CONFIG), CONFIG (a daemon configuration for every trial, default: built-in defaults),
+# DURATION_S (cut every trial to this long: CI's reduced run), JOBS (trials in parallel).
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+out=${1:-eval-full}
+eval_bin=${EVAL:-build/release/sim/companion-eval}
+trials=${TRIALS:-50}
+variant_trials=${VARIANT_TRIALS:-10}
+methods=${METHODS:-objective,fixed_behind,fixed_side,pid}
+extra=()
+if [[ -n "${CONFIG:-}" ]]; then extra+=(-c "$CONFIG"); fi
+if [[ -n "${DURATION_S:-}" ]]; then extra+=(--duration-s "$DURATION_S"); fi
+if [[ -n "${JOBS:-}" ]]; then extra+=(--jobs "$JOBS"); fi
+if [[ ! -x "$eval_bin" ]]; then
+  echo "run_benchmark: $eval_bin not found (make build, or set EVAL)" >&2
+  exit 2
+fi
+mkdir -p "$out"
+start=$(date +%s)
+run() {  # one companion-eval run into $out/$1, its console output kept in $out/$1.log
+  local name=$1
+  shift
+  "$eval_bin" "${extra[@]}" --method "$methods" --out "$out/$name" "$@" >"$out/$name.log"
+  tail -n 1 "$out/$name.log"
+}
+run paper --case paper --trials "$trials" --samples
+run variants --case crowds speeds sizes --trials "$variant_trials"
+for f in biwi_hotel crowds_zara01; do
+  run "recorded-$f" --pedestrians "sim/data/pedestrians/$f.txt" --frame-period 0.4 --samples
+done
+end=$(date +%s)
+for d in paper recorded-biwi_hotel recorded-crowds_zara01; do
+  /usr/bin/python3 sim/eval/plot_eval.py "$out/$d" >/dev/null
+done
+
+total=$(($(cat "$out"/*/trials.csv | grep -vc '^case,')))
+{
+  echo "# companion-eval: the full benchmark"
+  echo
+  echo "Command: \`sim/eval/run_benchmark.sh $out\` (TRIALS=$trials, VARIANT_TRIALS=$variant_trials,"
+  echo "METHODS=$methods${CONFIG:+, CONFIG=$CONFIG}${DURATION_S:+, DURATION_S=$DURATION_S}), $(date -u +%Y-%m-%d)," \
+    "commit $(git rev-parse --short HEAD 2>/dev/null || echo '?')."
+  echo
+  echo "$total trials in $((end - start)) s on $(nproc) cores:" \
+    "$(awk -v n="$total" -v s="$((end - start))" 'BEGIN { printf "%.1f", 60 * n / s }') trials/min."
+  for d in paper variants recorded-biwi_hotel recorded-crowds_zara01; do
+    echo
+    echo "# $d"
+    tail -n +2 "$out/$d/summary.md"
+  done
+} >"$out/REPORT.md"
+echo "run_benchmark: $out/REPORT.md ($total trials, $((end - start)) s)"
