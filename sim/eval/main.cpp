@@ -87,15 +87,6 @@ std::string csv_row(const Outcome& o, const std::string& scenario) {
       o.control_p99_ms, o.wall_s);
 }
 
-// The kind of a failure, from RunMetrics::failure ("collision with a pedestrian at t=..", "more
-// than 2 m from the person for 5 s at t=.."): what the tables count.
-std::string failure_kind(const std::string& failure) {
-  if (failure.find("an obstacle") != std::string::npos) return "hit obstacle";
-  if (failure.find("a pedestrian") != std::string::npos) return "hit pedestrian";
-  if (failure.find("the person") != std::string::npos) return "hit person";
-  return failure.rfind("more than", 0) == 0 ? "lost" : "other";
-}
-
 std::string causes_text(const std::map<std::string, int>& causes) {
   std::string out;
   for (const auto& [kind, count] : causes)
@@ -302,7 +293,7 @@ int run(int argc, char** argv) {
         if (o.trial.c != &c || o.trial.method->name != m.name) continue;
         ++n;
         ok += o.m.success ? 1 : 0;
-        if (!o.m.success) ++causes[failure_kind(o.m.failure)];
+        if (!o.m.success) ++causes[eval::failure_kind(o.m.failure)];
         collisions += o.m.collision ? 1 : 0;
         ut.push_back(o.m.uncomfortable_s);
         ex.push_back(o.m.rmse_ex_m);

@@ -10,7 +10,9 @@
 # TRIALS (random trials of scenario 7, default 50), VARIANT_TRIALS (per crowd/speed/size case,
 # default 10), METHODS (default objective,fixed_behind,fixed_side,pid; add policy with a policy
 # file in CONFIG), CONFIG (a daemon configuration for every trial, default: built-in defaults),
-# DURATION_S (cut every trial to this long: CI's reduced run), JOBS (trials in parallel).
+# DURATION_S (cut every trial to this long: CI's reduced run), JOBS (trials in parallel), STEPS
+# (default "paper variants recorded": run a subset again; the report takes every step's latest
+# results found in OUT).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 out=${1:-eval-full}
@@ -26,25 +28,36 @@ if [[ ! -x "$eval_bin" ]]; then
   echo "run_benchmark: $eval_bin not found (make build, or set EVAL)" >&2
   exit 2
 fi
+steps=${STEPS:-paper variants recorded}
 mkdir -p "$out"
-start=$(date +%s)
 run() {  # one companion-eval run into $out/$1, its console output kept in $out/$1.log
   local name=$1
   shift
   "$eval_bin" "${extra[@]}" --method "$methods" --out "$out/$name" "$@" >"$out/$name.log"
   tail -n 1 "$out/$name.log"
 }
-run paper --case paper --trials "$trials" --samples
-run variants --case crowds speeds sizes --trials "$variant_trials"
-for f in biwi_hotel crowds_zara01; do
-  run "recorded-$f" --pedestrians "sim/data/pedestrians/$f.txt" --frame-period 0.4 --samples
+for step in $steps; do
+  case $step in
+    paper) run paper --case paper --trials "$trials" --samples ;;
+    variants) run variants --case crowds speeds sizes --trials "$variant_trials" ;;
+    recorded)
+      for f in biwi_hotel crowds_zara01; do
+        run "recorded-$f" --pedestrians "sim/data/pedestrians/$f.txt" --frame-period 0.4 --samples
+      done
+      ;;
+    *)
+      echo "run_benchmark: unknown step '$step' (paper, variants, recorded)" >&2
+      exit 2
+      ;;
+  esac
 done
-end=$(date +%s)
 for d in paper recorded-biwi_hotel recorded-crowds_zara01; do
-  /usr/bin/python3 sim/eval/plot_eval.py "$out/$d" >/dev/null
+  if [[ -d "$out/$d" ]]; then /usr/bin/python3 sim/eval/plot_eval.py "$out/$d" >/dev/null; fi
 done
 
-total=$(($(cat "$out"/*/trials.csv | grep -vc '^case,')))
+# Totals from the runs' own summaries ("N trials in S s"): steps may have run separately.
+read -r total seconds < <(cat "$out"/*/summary.md | awk '/ trials in [0-9]+ s / {
+  n += $1; s += $4 } END { print n + 0, s + 0 }')
 {
   echo "# companion-eval: the full benchmark"
   echo
@@ -52,12 +65,13 @@ total=$(($(cat "$out"/*/trials.csv | grep -vc '^case,')))
   echo "METHODS=$methods${CONFIG:+, CONFIG=$CONFIG}${DURATION_S:+, DURATION_S=$DURATION_S}), $(date -u +%Y-%m-%d)," \
     "commit $(git rev-parse --short HEAD 2>/dev/null || echo '?')."
   echo
-  echo "$total trials in $((end - start)) s on $(nproc) cores:" \
-    "$(awk -v n="$total" -v s="$((end - start))" 'BEGIN { printf "%.1f", 60 * n / s }') trials/min."
+  echo "$total trials in $seconds s of wall time on $(nproc) cores:" \
+    "$(awk -v n="$total" -v s="$seconds" 'BEGIN { printf "%.1f", s > 0 ? 60 * n / s : 0 }') trials/min."
   for d in paper variants recorded-biwi_hotel recorded-crowds_zara01; do
+    [[ -f "$out/$d/summary.md" ]] || continue
     echo
     echo "# $d"
     tail -n +2 "$out/$d/summary.md"
   done
 } >"$out/REPORT.md"
-echo "run_benchmark: $out/REPORT.md ($total trials, $((end - start)) s)"
+echo "run_benchmark: $out/REPORT.md ($total trials, $seconds s)"
