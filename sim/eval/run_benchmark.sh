@@ -66,7 +66,7 @@ read -r total seconds < <(cat "$out"/*/summary.md | awk '/ trials in [0-9]+ s / 
     "commit $(git rev-parse --short HEAD 2>/dev/null || echo '?')."
   echo
   echo "$total trials in $seconds s of wall time on $(nproc) cores:" \
-    "$(awk -v n="$total" -v s="$seconds" 'BEGIN { printf "%.1f", s > 0 ? 60 * n / s : 0 }') trials/min."
+    "$(awk -v n="$total" -v s="$seconds" 'BEGIN { printf "%.1f", (s > 0 ? 60 * n / s : 0) }') trials/min."
   for d in paper variants recorded-biwi_hotel recorded-crowds_zara01; do
     [[ -f "$out/$d/summary.md" ]] || continue
     echo
