@@ -446,7 +446,7 @@ void Daemon::policy_task(const core::Tick& tick) {
         oi.robot_wz_radps = b->value.wz_radps;
       }
       oi.human = h;
-      oi.previous_action = previous_action_;
+      oi.previous_action = goal_hold_.index();
       const auto cs = space_.candidates();
       std::array<bool, 1024> mask{};
       for (size_t i = 0; i < cs.size() && i < mask.size(); ++i)
@@ -462,7 +462,6 @@ void Daemon::policy_task(const core::Tick& tick) {
     }
     s = goal_hold_.update(s, space_, tick.now);
     g.held = goal_hold_.held();
-    previous_action_ = goal_hold_.index();
     g.status = s.status;
     g.index = s.index;
     g.free_points = space_.free_count();
@@ -729,9 +728,10 @@ void Daemon::report_task(const core::Tick& tick) {
   if (const auto g = goal_.read(); g && (tracker_ || lidar_)) {
     const CompanionGoal& v = g->value;
     line += v.status == core::GoalStatus::kOk
-                ? fmt::format(" | goal {} {} of the person ({:+.2f}, {:+.2f}) m, {}/{} free",
+                ? fmt::format(" | goal {} {} of the person ({:+.2f}, {:+.2f}) m, {}/{} free{}",
                               v.selector, side_of_person(v.index, v.points), v.goal_base.x_m,
-                              v.goal_base.y_m, v.free_points, v.points)
+                              v.goal_base.y_m, v.free_points, v.points,
+                              v.held ? " (held: no free point)" : "")
                 : fmt::format(" | goal none: {}", core::to_string(v.status));
   }
   line += " | " + rates;

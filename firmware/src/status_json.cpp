@@ -45,6 +45,7 @@ std::string Daemon::build_status_json(core::Nanos now) const {
                  {"x_base_m", number(v.goal_base.x_m)},
                  {"y_base_m", number(v.goal_base.y_m)},
                  {"free_points", v.free_points},
+                 {"held", v.held},
                  {"points", v.points},
                  {"age_ms", age_ms(now, g->stamp)}};
   }

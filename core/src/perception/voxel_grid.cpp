@@ -256,6 +256,10 @@ void VoxelGrid::insert(std::span<const Ray> rays, const Pose2& robot,
   const Pose2 odom_to_base = robot.inverse();
   const uint16_t stamp = stamp_units(now);
   const double r2 = cfg_.person_mask_radius_m * cfg_.person_mask_radius_m;
+  // The segment the person swept during the scan (from -> to), once per scan.
+  const double sx = person ? person->to.x_m - person->from.x_m : 0.0;
+  const double sy = person ? person->to.y_m - person->from.y_m : 0.0;
+  const double len2 = sx * sx + sy * sy;
   for (const Ray& r : rays) {
     ++stats_.rays;
     if (!r.hit) {
@@ -273,10 +277,7 @@ void VoxelGrid::insert(std::span<const Ray> rays, const Pose2& robot,
       continue;
     }
     if (person) {
-      // Distance to the segment the person swept during the scan.
-      const double sx = person->to.x_m - person->from.x_m;
-      const double sy = person->to.y_m - person->from.y_m;
-      const double len2 = sx * sx + sy * sy;
+      // Distance to the swept segment.
       double ex = r.end.x - person->from.x_m;
       double ey = r.end.y - person->from.y_m;
       if (len2 > 1e-12) {

@@ -257,8 +257,7 @@ class Daemon {
   Selector selector_ = Selector::kAuto;  // policy.selector, resolved once
   std::unique_ptr<core::MlpPolicy> policy_;
   std::vector<float> observation_;
-  int previous_action_ = -1;
-  core::GoalHold goal_hold_;  // policy.hold_last_point_ms
+  core::GoalHold goal_hold_;  // policy.hold_last_point_ms; its index is the previous action
   core::LatestValue<CompanionGoal> goal_;
 
   // base (driver owned by the realtime group's thread: base and control tasks)

@@ -640,6 +640,7 @@ TEST(Daemon, WritesTheStatusFileAsJsonWithTheDocumentedKeys) {
   }
   EXPECT_EQ(j["control"]["tracking"], false) << "holding: nothing tracked";
   EXPECT_TRUE(j["goal"]["x_base_m"].is_number());
+  EXPECT_TRUE(j["goal"]["held"].is_boolean());
   EXPECT_EQ(d.daemon.status_json(), nlohmann::json::parse(d.daemon.status_json()).dump() + "\n");
 }
 
