@@ -161,6 +161,10 @@ int run(int argc, char** argv) {
   app.add_option("--duration-s", duration_s, "cut every trial to this long (0: the scenario's)")
       ->check(CLI::NonNegativeNumber);
   app.add_flag("--samples", samples, "also write each trial's samples (100 ms) for the plots");
+  bool daemon_log = false;
+  app.add_flag("--daemon-log", daemon_log,
+               "print the daemons' log (info: every failsafe transition) to diagnose a trial; "
+               "use with one trial, or --jobs 1, to keep the lines in order");
   CLI11_PARSE(app, argc, argv);
 
   const auto loaded = config_path.empty() ? firmware::load_default_config()
@@ -219,7 +223,8 @@ int run(int argc, char** argv) {
     }
   }
   std::filesystem::create_directories(out_dir);
-  spdlog::set_level(spdlog::level::err);  // trials run quietly; failures are in the results
+  // Trials run quietly; failures are in the results.
+  spdlog::set_level(daemon_log ? spdlog::level::info : spdlog::level::err);
   std::cout << fmt::format("companion-eval: {} trials ({} cases x {} methods), {} in parallel\n",
                            plan.size(), cases.size(), methods.size(), jobs);
 
@@ -232,6 +237,7 @@ int run(int argc, char** argv) {
     for (size_t i = next.fetch_add(1); i < plan.size(); i = next.fetch_add(1)) {
       const eval::Trial& t = plan[i];
       sim::SimRunOptions o;
+      o.quiet = !daemon_log;
       o.config = eval::trial_config(*loaded.config, *t.c, *t.method);
       o.scenario = recorded ? *recorded : eval::make_world(*t.c, t.seed);
       o.seed = t.seed;

@@ -118,6 +118,8 @@ void RunMetricsRecorder::record(double t_s, double dt_s, const core::Pose2& robo
     s.goal = {view.goal_world.x_m, view.goal_world.y_m};
     s.active = view.active;
     s.side = view.side;
+    s.cmd_vx_mps = view.cmd_vx;
+    s.cmd_vy_mps = view.cmd_vy;
     samples_.push_back(std::move(s));
     next_sample_s_ = t_s + config_.sample_period_s;
   }

@@ -19,7 +19,7 @@ double Crowd::fov_weight(const Point2& desired_dir, const Point2& force) const {
   return cos_angle >= std::cos(params_.fov_half_rad) ? 1.0 : params_.outside_fov_weight;
 }
 
-Point2 Crowd::person_force(const Point2& self, const Point2& desired_dir,
+Point2 Crowd::person_force(const Point2& self, double self_radius_m, const Point2& desired_dir,
                            const MovingBody& other) const {
   const double speed = norm(other.velocity);
   const double s = speed * params_.step_width_s;
@@ -34,8 +34,17 @@ Point2 Crowd::person_force(const Point2& self, const Point2& desired_dir,
     const double b = 0.5 * std::sqrt(std::max(sum * sum - s * s, 0.0));
     return params_.v0_m2ps2 * std::exp(-b / params_.sigma_m);
   };
-  const double rx = self.x_m - other.position.x_m;
-  const double ry = self.y_m - other.position.y_m;
+  // r is taken between the bodies' surfaces (as r_ij - d_ij in Helbing, Farkas & Vicsek 2000):
+  // Helbing & Molnar's people are points, and with centre distances a walker leaned into a
+  // standing robot until the centres were ~0.3 m apart, i.e. walked through its body.
+  const double cx = self.x_m - other.position.x_m;
+  const double cy = self.y_m - other.position.y_m;
+  const double centres_m = std::hypot(cx, cy);
+  constexpr double kMinSurfaceM = 1e-3;  // overlapping bodies push apart along the centre line
+  const double surface_m = std::max(centres_m - self_radius_m - other.radius_m, kMinSurfaceM);
+  const double scale = centres_m > 1e-9 ? surface_m / centres_m : 0.0;
+  const double rx = centres_m > 1e-9 ? cx * scale : surface_m;
+  const double ry = cy * scale;
   constexpr double kStep = 1e-4;
   const Point2 f{-(potential(rx + kStep, ry) - potential(rx - kStep, ry)) / (2 * kStep),
                  -(potential(rx, ry + kStep) - potential(rx, ry - kStep)) / (2 * kStep)};
@@ -109,13 +118,13 @@ void Crowd::step(double dt_s, const StaticWorld& world, std::span<const MovingBo
     };
     for (size_t j = 0; j < bodies_.size(); ++j) {
       if (j == i || !near(bodies_[j].position)) continue;
-      const Point2 f = person_force(p.position, dir, bodies_[j]);
+      const Point2 f = person_force(p.position, p.radius_m, dir, bodies_[j]);
       a.x_m += f.x_m;
       a.y_m += f.y_m;
     }
     for (const MovingBody& o : others) {
       if (!near(o.position)) continue;
-      const Point2 f = person_force(p.position, dir, o);
+      const Point2 f = person_force(p.position, p.radius_m, dir, o);
       a.x_m += f.x_m;
       a.y_m += f.y_m;
     }

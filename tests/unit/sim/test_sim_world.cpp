@@ -13,6 +13,7 @@
 #include "hal/sim_clock.hpp"
 #include "sim/pedestrian_dataset.hpp"
 #include "sim/run_metrics.hpp"
+#include "sim/run_report.hpp"
 #include "sim/sim_vlp16.hpp"
 #include "sim/sim_world.hpp"
 #include "sim/social_force.hpp"
@@ -180,13 +181,40 @@ TEST(SocialForce, WallsRepelAndForcesFromBehindCountHalf) {
   // A standing person 1 m ahead vs 1 m behind: the same magnitude, behind weighted 0.5.
   const sim::MovingBody ahead{{1, 0}, {0, 0}, 0.25};
   const sim::MovingBody behind{{-1, 0}, {0, 0}, 0.25};
-  const Point2 fa = crowd.person_force({0, 0}, {1, 0}, ahead);
-  const Point2 fb = crowd.person_force({0, 0}, {1, 0}, behind);
+  const Point2 fa = crowd.person_force({0, 0}, 0.0, {1, 0}, ahead);
+  const Point2 fb = crowd.person_force({0, 0}, 0.0, {1, 0}, behind);
   EXPECT_LT(fa.x_m, 0.0) << "pushed back";
   EXPECT_GT(fb.x_m, 0.0) << "pushed forward";
   EXPECT_NEAR(fb.x_m, -0.5 * fa.x_m, 1e-6);
-  // V0/sigma exp(-b/sigma) with b = |r| for a standing person.
-  EXPECT_NEAR(-fa.x_m, 2.1 / 0.3 * std::exp(-1.0 / 0.3), 1e-4);
+  // V0/sigma exp(-b/sigma) with b the distance between the surfaces for a standing person.
+  EXPECT_NEAR(-fa.x_m, 2.1 / 0.3 * std::exp(-(1.0 - 0.25) / 0.3), 1e-4);
+  const Point2 wide = crowd.person_force({0, 0}, 0.3, {1, 0}, ahead);
+  EXPECT_NEAR(-wide.x_m, 2.1 / 0.3 * std::exp(-(1.0 - 0.25 - 0.3) / 0.3), 1e-4)
+      << "the walker's own radius counts too";
+}
+
+TEST(SocialForce, AWalkerGoesAroundAStandingRobotWithoutTouchingIt) {
+  // The robot is seen at its size (0.45 m): with centre distances (Helbing & Molnar's points) a
+  // walker leaned into it until the centres were ~0.3 m apart, i.e. through its body.
+  for (const double offset_m : {0.05, 0.2, 0.4}) {
+    sim::Crowd crowd;
+    sim::Pedestrian p;
+    p.position = {0, offset_m};
+    p.velocity = {1.2, 0};
+    p.radius_m = 0.3;
+    p.goals = {{10, offset_m}};
+    crowd.add(p);
+    const sim::MovingBody robot{{5, 0}, {0, 0}, 0.45};
+    double closest_gap_m = 1e9;
+    for (int i = 0; i < 1500; ++i) {
+      crowd.step(0.01, sim::StaticWorld{}, std::span<const sim::MovingBody>(&robot, 1));
+      const auto& q = crowd.people()[0];
+      closest_gap_m = std::min(closest_gap_m, std::hypot(q.position.x_m - 5, q.position.y_m) -
+                                                  p.radius_m - robot.radius_m);
+    }
+    EXPECT_GT(closest_gap_m, 0.05) << "offset " << offset_m;
+    EXPECT_TRUE(crowd.people()[0].arrived()) << "offset " << offset_m << ": and goes on";
+  }
 }
 
 TEST(SocialForce, ALoopingWalkerWhoseGoalsAreAllWhereTheyStandDoesNotHangTheStep) {
@@ -425,4 +453,17 @@ TEST(RunMetrics, SectorsNameTheSidesOfThePerson) {
   EXPECT_STREQ(sim::sector_name(sim::sector_of(std::numbers::pi)), "behind");
   EXPECT_STREQ(sim::sector_name(sim::sector_of(-std::numbers::pi)), "behind");
   EXPECT_STREQ(sim::sector_name(sim::sector_of(-std::numbers::pi / 2)), "right");
+}
+
+TEST(RunMetrics, SamplesCarryTheDaemonsCommandToDiagnoseATrial) {
+  sim::RunMetricsRecorder r;
+  sim::DaemonView v;
+  v.active = true;
+  v.cmd_vx = 0.75;
+  v.cmd_vy = -0.25;
+  r.record(0.0, 0.01, Pose2{-1, 0, 0}, Pose2{0, 0, 0}, {}, 5.0, 1.0, v);
+  ASSERT_EQ(r.samples().size(), 1U);
+  const std::string csv = sim::samples_csv(r.samples());
+  EXPECT_NE(csv.find(",cmd_vx_mps,cmd_vy_mps\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",0.750,-0.250\n"), std::string::npos) << csv;
 }

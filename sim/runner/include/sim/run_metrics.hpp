@@ -26,7 +26,8 @@ struct RunSample {  // for pictures: every 100 ms
   bool has_goal = false;
   core::Point2 goal;  // q^d in the world
   bool active = false;
-  int side = -1;  // sector of the chosen point (0..7), -1 none
+  int side = -1;                          // sector of the chosen point (0..7), -1 none
+  double cmd_vx_mps = 0, cmd_vy_mps = 0;  // the daemon's last command, base_link
 };
 
 struct RunMetrics {

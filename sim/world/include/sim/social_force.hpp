@@ -2,7 +2,8 @@
 // Pedestrians that walk to their goals and avoid each other, the person, the robot and the walls:
 // the social-force model of Helbing & Molnar (1995) with the common parameter set
 // (reference/evaluation.md): relaxation to the desired velocity in tau, an elliptical repulsive
-// potential V0 exp(-b / sigma) between people (b from the other's step s = |v| dt), a wall
+// potential V0 exp(-b / sigma) between people (b from the other's step s = |v| dt and the distance
+// between the bodies' surfaces, so the robot and wide people are avoided at their size), a wall
 // potential U0 exp(-d / R), a field of view of +-100 degrees outside of which forces count half,
 // and a speed cap at 1.3x the desired speed. Integrated with semi-implicit Euler.
 #include <cstdint>
@@ -57,8 +58,8 @@ class Crowd {
   [[nodiscard]] const SocialForceParams& params() const { return params_; }
 
   // The force on `self` from a person at `other` (exposed for the unit tests).
-  [[nodiscard]] Point2 person_force(const Point2& self, const Point2& desired_dir,
-                                    const MovingBody& other) const;
+  [[nodiscard]] Point2 person_force(const Point2& self, double self_radius_m,
+                                    const Point2& desired_dir, const MovingBody& other) const;
   [[nodiscard]] Point2 wall_force(const Point2& self, const Point2& desired_dir,
                                   const StaticWorld& world) const;
 
