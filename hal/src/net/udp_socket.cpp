@@ -63,7 +63,8 @@ UdpReceiver::~UdpReceiver() {
   ::close(fd_);
 }
 
-UdpReceiver::OpenResult UdpReceiver::open(const UdpEndpoint& endpoint, int receive_buffer_bytes) {
+UdpReceiver::OpenResult UdpReceiver::open(const UdpEndpoint& endpoint, int receive_buffer_bytes,
+                                          UdpStamp stamp) {
   OpenResult r;
   sockaddr_in sa{};
   if (!to_sockaddr(endpoint, sa)) {
@@ -78,7 +79,8 @@ UdpReceiver::OpenResult UdpReceiver::open(const UdpEndpoint& endpoint, int recei
   const int one = 1;
   // Sensors broadcast; several listeners (the daemon and a diagnostics tool) may share the port.
   (void)setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof(one));
-  (void)setsockopt(fd, SOL_SOCKET, SO_TIMESTAMPNS, &one, sizeof(one));
+  if (stamp == UdpStamp::kKernel)
+    (void)setsockopt(fd, SOL_SOCKET, SO_TIMESTAMPNS, &one, sizeof(one));
   (void)setsockopt(fd, SOL_SOCKET, SO_RXQ_OVFL, &one, sizeof(one));
   // SO_RCVBUFFORCE passes net.core.rmem_max with CAP_NET_ADMIN; otherwise the capped request.
   if (setsockopt(fd, SOL_SOCKET, SO_RCVBUFFORCE, &receive_buffer_bytes,

@@ -497,7 +497,8 @@ class RoundRoom {
 }  // namespace
 
 TEST(DaemonWithLidar, BuildsTheCostmapAndFeedsTheSupervisor) {
-  auto opened = hal::UdpReceiver::open({"127.0.0.1", 0});
+  // Stamped at the drain: the test runs on the simulated clock.
+  auto opened = hal::UdpReceiver::open({"127.0.0.1", 0}, 4 << 20, hal::UdpStamp::kDrain);
   ASSERT_TRUE(opened.receiver) << opened.error;
   RoundRoom room(opened.receiver->port());
   std::map<Nanos, firmware::SafetySnapshot> seen;
@@ -530,7 +531,8 @@ TEST(DaemonWithLidar, BuildsTheCostmapAndFeedsTheSupervisor) {
 }
 
 TEST(DaemonWithTrackerAndLidar, ChoosesACompanionPointAroundThePerson) {
-  auto opened = hal::UdpReceiver::open({"127.0.0.1", 0});
+  // Stamped at the drain: the test runs on the simulated clock.
+  auto opened = hal::UdpReceiver::open({"127.0.0.1", 0}, 4 << 20, hal::UdpStamp::kDrain);
   ASSERT_TRUE(opened.receiver) << opened.error;
   RoundRoom room(opened.receiver->port());
   // The goal as chosen while the robot still stands (once ACTIVE the controller moves it, and the
@@ -595,7 +597,8 @@ TEST(DaemonWithTrackerAndLidar, ALoadedPolicyChoosesAmongTheFreePoints) {
                                          static_cast<uint32_t>(in));
   ASSERT_TRUE(loaded.policy) << loaded.error;
 
-  auto opened = hal::UdpReceiver::open({"127.0.0.1", 0});
+  // Stamped at the drain: the test runs on the simulated clock.
+  auto opened = hal::UdpReceiver::open({"127.0.0.1", 0}, 4 << 20, hal::UdpStamp::kDrain);
   ASSERT_TRUE(opened.receiver) << opened.error;
   RoundRoom room(opened.receiver->port());
   DaemonWithBase d(

@@ -61,6 +61,33 @@ TEST(UdpReceiver, ReceivesWithKernelStampsAndSource) {
   EXPECT_EQ(rx.drain(10, now, [](const hal::UdpDatagram&) {}), 0U) << "non-blocking when empty";
 }
 
+TEST(UdpReceiver, OnASimulatedClockDatagramsTakeTheDrainsTime) {
+  // The kernel stamp is aged back from `now` by the wall time the datagram waited: right on the
+  // robot, wrong on a simulated clock, where `now` is not the wall clock's (a loaded machine
+  // aged a test's scans into 'lidar silent'). kDrain stamps with `now` itself.
+  auto kernel = hal::UdpReceiver::open({"127.0.0.1", 0});
+  auto drain = hal::UdpReceiver::open({"127.0.0.1", 0}, 4 << 20, hal::UdpStamp::kDrain);
+  ASSERT_TRUE(kernel.receiver && drain.receiver);
+  std::string err;
+  auto tx = hal::UdpSender::open(err);
+  ASSERT_TRUE(tx) << err;
+  const std::vector<uint8_t> payload(100, 7);
+  ASSERT_TRUE(tx->send_to({"127.0.0.1", kernel.receiver->port()}, payload));
+  ASSERT_TRUE(tx->send_to({"127.0.0.1", drain.receiver->port()}, payload));
+  ASSERT_TRUE(wait_readable(kernel.receiver->fd()));
+  ASSERT_TRUE(wait_readable(drain.receiver->fd()));
+  const hal::Nanos sim_now = 5s;  // a simulated clock's time, far from the wall clock's
+  std::vector<hal::Nanos> kernel_stamps, drain_stamps;
+  kernel.receiver->drain(10, sim_now,
+                         [&](const hal::UdpDatagram& d) { kernel_stamps.push_back(d.stamp); });
+  drain.receiver->drain(10, sim_now,
+                        [&](const hal::UdpDatagram& d) { drain_stamps.push_back(d.stamp); });
+  ASSERT_EQ(kernel_stamps.size(), 1U);
+  ASSERT_EQ(drain_stamps.size(), 1U);
+  EXPECT_LT(kernel_stamps[0], sim_now) << "aged by the wall time it waited";
+  EXPECT_EQ(drain_stamps[0], sim_now);
+}
+
 TEST(UdpReceiver, CountsTruncatedAndKernelDrops) {
   auto opened = hal::UdpReceiver::open({"127.0.0.1", 0}, 4096);  // tiny queue on purpose
   ASSERT_TRUE(opened.receiver) << opened.error;

@@ -22,6 +22,12 @@ struct UdpEndpoint {
 // "udp:<addr>:<port>" or "<addr>:<port>"; nullopt-like: returns false and says why.
 bool parse_udp_endpoint(const std::string& text, UdpEndpoint& out, std::string& error);
 
+// How a datagram is stamped: by the kernel at arrival (SO_TIMESTAMPNS, aged back from the drain's
+// `now`: the real daemon), or with the drain's `now` (a simulated clock: the wall time a datagram
+// waited in the kernel means nothing there, and on a loaded machine it aged scans into
+// staleness).
+enum class UdpStamp { kKernel, kDrain };
+
 class UdpReceiver final : public DatagramSource {
  public:
   struct OpenResult {
@@ -29,7 +35,8 @@ class UdpReceiver final : public DatagramSource {
     std::string error;
   };
   // `receive_buffer_bytes`: SO_RCVBUF asked for (the kernel may cap it: see buffer_bytes()).
-  static OpenResult open(const UdpEndpoint& endpoint, int receive_buffer_bytes = 4 << 20);
+  static OpenResult open(const UdpEndpoint& endpoint, int receive_buffer_bytes = 4 << 20,
+                         UdpStamp stamp = UdpStamp::kKernel);
   ~UdpReceiver() override;
   UdpReceiver(const UdpReceiver&) = delete;
   UdpReceiver& operator=(const UdpReceiver&) = delete;
