@@ -134,12 +134,4 @@ firmware::DaemonConfig trial_config(const firmware::DaemonConfig& base, const Ca
   return cfg;
 }
 
-std::string failure_kind(const std::string& failure) {
-  if (failure.rfind("collision with an obstacle", 0) == 0) return "hit obstacle";
-  if (failure.rfind("collision with a pedestrian", 0) == 0) return "hit pedestrian";
-  if (failure.rfind("collision with the person", 0) == 0) return "hit person";
-  // "more than 2 m from the person for 5 s" names the person too: it is not a collision.
-  return failure.rfind("more than", 0) == 0 ? "lost" : "other";
-}
-
 }  // namespace eval

@@ -48,9 +48,4 @@ sim::Scenario make_world(const Case& c, uint32_t seed);
 firmware::DaemonConfig trial_config(const firmware::DaemonConfig& base, const Case& c,
                                     const Method& m);
 
-// The kind of a failure, from RunMetrics::failure ("collision with a pedestrian at t=..", "more
-// than 2 m from the person for 5 s at t=.."): "hit obstacle", "hit pedestrian", "hit person",
-// "lost" or "other". What the tables count.
-std::string failure_kind(const std::string& failure);
-
 }  // namespace eval

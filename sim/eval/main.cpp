@@ -299,7 +299,7 @@ int run(int argc, char** argv) {
         if (o.trial.c != &c || o.trial.method->name != m.name) continue;
         ++n;
         ok += o.m.success ? 1 : 0;
-        if (!o.m.success) ++causes[eval::failure_kind(o.m.failure)];
+        if (!o.m.success) ++causes[sim::to_string(o.m.failure_kind)];
         collisions += o.m.collision ? 1 : 0;
         ut.push_back(o.m.uncomfortable_s);
         ex.push_back(o.m.rmse_ex_m);

@@ -11,6 +11,22 @@
 
 namespace sim {
 
+const char* to_string(FailureKind k) {
+  switch (k) {
+    case FailureKind::kNone:
+      return "-";
+    case FailureKind::kHitObstacle:
+      return "hit obstacle";
+    case FailureKind::kHitPedestrian:
+      return "hit pedestrian";
+    case FailureKind::kHitPerson:
+      return "hit person";
+    case FailureKind::kLost:
+      return "lost";
+  }
+  return "?";
+}
+
 namespace {
 constexpr double kJerkStepS = 0.02;
 }  // namespace
@@ -45,9 +61,12 @@ void RunMetricsRecorder::record(double t_s, double dt_s, const core::Pose2& robo
         nearest_pedestrian_m =
             std::min(nearest_pedestrian_m, std::hypot(robot.x_m - p.x_m, robot.y_m - p.y_m));
       }
-      const char* what = static_clearance_m <= 0     ? "an obstacle"
-                         : d <= nearest_pedestrian_m ? "the person"
-                                                     : "a pedestrian";
+      m_.failure_kind = static_clearance_m <= 0     ? FailureKind::kHitObstacle
+                        : d <= nearest_pedestrian_m ? FailureKind::kHitPerson
+                                                    : FailureKind::kHitPedestrian;
+      const char* what = m_.failure_kind == FailureKind::kHitObstacle ? "an obstacle"
+                         : m_.failure_kind == FailureKind::kHitPerson ? "the person"
+                                                                      : "a pedestrian";
       m_.failure = fmt::format("collision with {} at t={:.1f} s", what, t_s);
     }
   }
@@ -58,6 +77,7 @@ void RunMetricsRecorder::record(double t_s, double dt_s, const core::Pose2& robo
     m_.longest_far_s = std::max(m_.longest_far_s, far_for);
     if (far_for > config_.far_max_s && m_.success) {
       m_.success = false;
+      m_.failure_kind = FailureKind::kLost;
       m_.failure = fmt::format("more than {:.0f} m from the person for {:.0f} s at t={:.1f} s",
                                config_.far_m, config_.far_max_s, t_s);
     }

@@ -67,12 +67,3 @@ TEST(EvalPlan, RandomWorldsDifferBySeedAndRepeatForTheSameSeed) {
   EXPECT_EQ(a.person.end_s(), a2.person.end_s());
   EXPECT_EQ(a.world.segments.size(), a2.world.segments.size());
 }
-
-TEST(EvalPlan, FailuresAreCountedByKind) {
-  EXPECT_EQ(eval::failure_kind("collision with a pedestrian at t=8.4 s"), "hit pedestrian");
-  EXPECT_EQ(eval::failure_kind("collision with the person at t=13.9 s"), "hit person");
-  EXPECT_EQ(eval::failure_kind("collision with an obstacle at t=17.6 s"), "hit obstacle");
-  // Names the person, but is not a collision (the first version counted it as one).
-  EXPECT_EQ(eval::failure_kind("more than 2 m from the person for 5 s at t=15.4 s"), "lost");
-  EXPECT_EQ(eval::failure_kind(""), "other");
-}

@@ -411,6 +411,7 @@ TEST(RunMetrics, UncomfortableTimeFarFailureAndCollision) {
   EXPECT_FALSE(m.success);
   EXPECT_NE(m.failure.find("from the person for 5 s"), std::string::npos) << m.failure;
   EXPECT_FALSE(m.collision);
+  EXPECT_EQ(m.failure_kind, sim::FailureKind::kLost) << "names the person, but is no collision";
   EXPECT_NEAR(m.side_time_s[4], 7.0, 0.02) << "behind";
 
   sim::RunMetricsRecorder c;
@@ -420,16 +421,20 @@ TEST(RunMetrics, UncomfortableTimeFarFailureAndCollision) {
   EXPECT_TRUE(m.collision);
   EXPECT_FALSE(m.success);
   EXPECT_NE(m.failure.find("obstacle"), std::string::npos);
+  EXPECT_EQ(m.failure_kind, sim::FailureKind::kHitObstacle);
 
   // Touching people: the nearer centre names who (the tables count the kinds).
   sim::RunMetricsRecorder pedestrian;
   pedestrian.record(0.0, 0.01, Pose2{-1, 0, 0}, person, {{-1.0, 0.5}}, 5.0, 0.0, v);
   EXPECT_NE(pedestrian.finish().failure.find("collision with a pedestrian"), std::string::npos)
       << pedestrian.finish().failure;
+  EXPECT_EQ(pedestrian.finish().failure_kind, sim::FailureKind::kHitPedestrian);
   sim::RunMetricsRecorder same;
   same.record(0.0, 0.01, Pose2{-0.5, 0, 0}, person, {{-1.5, 1.0}}, 5.0, 0.0, v);
   EXPECT_NE(same.finish().failure.find("collision with the person"), std::string::npos)
       << same.finish().failure;
+  EXPECT_EQ(same.finish().failure_kind, sim::FailureKind::kHitPerson);
+  EXPECT_STREQ(sim::to_string(sim::FailureKind::kHitPerson), "hit person");
 }
 
 TEST(RunMetrics, TrackingErrorIsInTheRobotFrame) {

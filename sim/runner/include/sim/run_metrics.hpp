@@ -30,10 +30,16 @@ struct RunSample {  // for pictures: every 100 ms
   double cmd_vx_mps = 0, cmd_vy_mps = 0;  // the daemon's last command, base_link
 };
 
+// What failed a run first: the tables count these.
+enum class FailureKind { kNone, kHitObstacle, kHitPedestrian, kHitPerson, kLost };
+const char* to_string(
+    FailureKind k);  // "-", "hit obstacle", "hit pedestrian", "hit person", "lost"
+
 struct RunMetrics {
   double duration_s = 0;
   bool success = true;
-  std::string failure;  // "" or "collision with ... at t=..", "lost the person ..."
+  std::string failure;  // "" or "collision with ... at t=..", "more than 2 m from the person ..."
+  FailureKind failure_kind = FailureKind::kNone;
   bool collision = false;
   double collision_t_s = -1;
   double longest_far_s = 0;  // longest stretch > 2 m from the person
