@@ -1,5 +1,6 @@
 #include "firmware/lidar_pipeline.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace firmware {
@@ -13,6 +14,13 @@ core::VoxelGridConfig voxel_grid_config(const DaemonConfig& cfg) {
   g.z_max_m = c.z_max_m;
   g.decay_s = c.decay_s;
   g.clear_max_range_m = c.clear_max_range_m;
+  g.clear_seen_through = c.clear_seen_through;
+  g.hidden_decay_s = c.hidden_decay_s;
+  // Above the top beam nothing is seen; a tilted mount raises it on one side (counted everywhere:
+  // the conservative way, fewer voxels are taken for out of view).
+  const auto& el = vlp16::laser_table(vlp16::Product::kVlp16).elevation_rad;
+  g.view_top_rad = *std::max_element(el.begin(), el.end()) + std::abs(cfg.lidar.roll_rad) +
+                   std::abs(cfg.lidar.pitch_rad);
   g.footprint_x_min_m = c.footprint_x_min_m;
   g.footprint_x_max_m = c.footprint_x_max_m;
   g.footprint_y_min_m = c.footprint_y_min_m;

@@ -165,6 +165,10 @@ int run(int argc, char** argv) {
   app.add_flag("--daemon-log", daemon_log,
                "print the daemons' log (info: every failsafe transition) to diagnose a trial; "
                "use with one trial, or --jobs 1, to keep the lines in order");
+  bool person_walks_through = false;
+  app.add_flag("--person-walks-through", person_walks_through,
+               "the followed person keeps to their script even into the robot (default: they "
+               "do not walk into it; contacts the robot causes count either way)");
   CLI11_PARSE(app, argc, argv);
 
   const auto loaded = config_path.empty() ? firmware::load_default_config()
@@ -242,6 +246,7 @@ int run(int argc, char** argv) {
       o.scenario = recorded ? *recorded : eval::make_world(*t.c, t.seed);
       o.seed = t.seed;
       o.duration_s = duration_s;
+      o.person_avoids_robot = !person_walks_through;
       const sim::SimRunResult r = sim::run_simulation(o);
       Outcome& out = outcomes[i];
       out.trial = t;

@@ -63,8 +63,8 @@ double quantile(const std::vector<double>& v, double q) {
   return s[static_cast<size_t>(q * static_cast<double>(s.size() - 1))];
 }
 
-// Arg: the no-return clearing range (0: off; 8: costmap.clear_on_no_return with the default
-// clear_max_range_m), so one run compares the two.
+// Args: the no-return clearing range (0: off; 8: costmap.clear_on_no_return with the default
+// clear_max_range_m) and costmap.clear_seen_through (0 / 1), so one run compares them.
 void BM_LidarCycle(benchmark::State& state) {
   const auto packets = capture();
   vlp16::DecodeOptions decode;
@@ -72,6 +72,8 @@ void BM_LidarCycle(benchmark::State& state) {
   core::VoxelGridConfig gc;  // 12 m x 12 m at 5 cm, 0.05..2.0 m band (39 layers)
   gc.size_xy_m = 12.0;
   gc.resolution_m = 0.05;
+  gc.clear_max_range_m = 8.0;
+  gc.clear_seen_through = state.range(1) != 0;
   core::VoxelGrid grid(gc);
   core::Costmap costmap;
   const core::CostmapConfig cc;
@@ -116,8 +118,9 @@ void BM_LidarCycle(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_LidarCycle)
-    ->Arg(0)
-    ->Arg(8)
+    ->Args({0, 0})
+    ->Args({8, 0})
+    ->Args({8, 1})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(1)
     ->Repetitions(200)

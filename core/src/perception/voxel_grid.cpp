@@ -36,7 +36,10 @@ VoxelGrid::VoxelGrid(const VoxelGridConfig& config)
       stamp_(mask_.size() * static_cast<size_t>(nz_), 0),
       block_count_(static_cast<size_t>(n_ / kBlock) * static_cast<size_t>(n_ / kBlock), 0),
       traced_(1 << 17, 0),
-      traced_scan_(traced_.size(), 0) {}
+      traced_scan_(traced_.size(), 0),
+      depth_(static_cast<size_t>(kAzimuthBins) * kElevationBins, -1.0f),
+      azimuth_origin_(kAzimuthBins),
+      azimuth_seen_(kAzimuthBins, 0) {}
 
 size_t VoxelGrid::block_of(size_t col) const {
   const size_t i = col % static_cast<size_t>(n_);
@@ -302,6 +305,227 @@ void VoxelGrid::insert(std::span<const Ray> rays, const Pose2& robot,
     stamp_[col * static_cast<size_t>(nz_) + static_cast<size_t>(cz)] = stamp;
     ++stats_.marked;
   }
+  if (cfg_.clear_seen_through) clear_seen_through(rays, stamp);
+  if (person) clear_person(*person);
+}
+
+// Where the tracked person stands, nothing else can: the voxels there are freed. The robot
+// following someone sees little past them, and what a pedestrian left there (unseen in the
+// person's shadow, so neither ray-cleared nor seen through) would otherwise be an obstacle the
+// person walks into, closing their interactive space around them.
+void VoxelGrid::clear_person(const PersonSweep& person) {
+  const double r = cfg_.person_mask_radius_m;
+  const double sx = person.to.x_m - person.from.x_m;
+  const double sy = person.to.y_m - person.from.y_m;
+  const double len2 = sx * sx + sy * sy;
+  const int64_t x0 = floor_to_int((std::min(person.from.x_m, person.to.x_m) - r) / res_);
+  const int64_t x1 = floor_to_int((std::max(person.from.x_m, person.to.x_m) + r) / res_);
+  const int64_t y0 = floor_to_int((std::min(person.from.y_m, person.to.y_m) - r) / res_);
+  const int64_t y1 = floor_to_int((std::max(person.from.y_m, person.to.y_m) + r) / res_);
+  for (int64_t cy = std::max(y0, oy_); cy <= std::min(y1, oy_ + n_ - 1); ++cy) {
+    for (int64_t cx = std::max(x0, ox_); cx <= std::min(x1, ox_ + n_ - 1); ++cx) {
+      const size_t col = slot(cx, cy);
+      if (mask_[col] == 0) continue;
+      double ex = (static_cast<double>(cx) + 0.5) * res_ - person.from.x_m;
+      double ey = (static_cast<double>(cy) + 0.5) * res_ - person.from.y_m;
+      if (len2 > 1e-12) {
+        const double u = std::clamp((ex * sx + ey * sy) / len2, 0.0, 1.0);
+        ex -= u * sx;
+        ey -= u * sy;
+      }
+      if (ex * ex + ey * ey > r * r) continue;
+      stats_.person_cleared += static_cast<uint64_t>(std::popcount(mask_[col]));
+      set_column(col, 0);
+    }
+  }
+}
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kAzimuthBinRad = 2.0 * kPi / 720.0;
+constexpr double kElevationBinRad = kPi / 180.0;
+constexpr int kElevationSearchBins = 3;  // VLP-16 beams are 2 degrees apart
+}  // namespace
+
+// Ray casting frees the voxels a ray crosses, at the heights it crosses them. From a moving robot
+// the beams cross a vacated place at other heights than those that marked it, so a walking
+// pedestrian left a trail for decay_s: a wall along the path of anyone the robot follows. The
+// spatio-temporal voxel layer (which the paper uses) frees what lies in the sensor's frustum and
+// was not seen again; this does the same, but occlusion-aware: a voxel is freed only when the
+// scan's beams beside it reached beyond it (a voxel behind the person or a wall stays).
+void VoxelGrid::clear_seen_through(std::span<const Ray> rays, uint16_t stamp) {
+  std::fill(depth_.begin(), depth_.end(), -1.0f);
+  std::fill(azimuth_seen_.begin(), azimuth_seen_.end(), 0);
+  Point3 mean{};
+  size_t used = 0;
+  for (const Ray& r : rays) {
+    const double vx = r.end.x - r.origin.x;
+    const double vy = r.end.y - r.origin.y;
+    const double vz = r.end.z - r.origin.z;
+    const double h = std::hypot(vx, vy);
+    if (!(h > 1e-6)) continue;
+    const double el = std::atan2(vz, h);
+    const auto ei = static_cast<int>(floor_to_int(el / kElevationBinRad)) + kElevationBins / 2;
+    if (ei < 0 || ei >= kElevationBins) continue;
+    const auto ai =
+        static_cast<int>(floor_to_int((std::atan2(vy, vx) + kPi) / kAzimuthBinRad)) % kAzimuthBins;
+    float& d = depth_[static_cast<size_t>(ai * kElevationBins + ei)];
+    const auto range = static_cast<float>(std::hypot(h, vz));
+    if (azimuth_seen_[static_cast<size_t>(ai)] == 0) {
+      azimuth_seen_[static_cast<size_t>(ai)] = 1;
+      azimuth_origin_[static_cast<size_t>(ai)] = r.origin;
+    }
+    d = d < 0.0f ? range : std::min(d, range);
+    mean.x += r.origin.x;
+    mean.y += r.origin.y;
+    mean.z += r.origin.z;
+    ++used;
+  }
+  if (used == 0) return;
+  const auto inv = 1.0 / static_cast<double>(used);
+  mean = {mean.x * inv, mean.y * inv, mean.z * inv};
+  const double reach2 = cfg_.clear_max_range_m * cfg_.clear_max_range_m;
+  const auto hidden_max_age = static_cast<uint16_t>(std::min(60000.0, cfg_.hidden_decay_s * 100.0));
+  for (int64_t cy = oy_; cy < oy_ + n_; ++cy) {
+    for (int64_t cx = ox_; cx < ox_ + n_; ++cx) {
+      const size_t col = slot(cx, cy);
+      uint64_t m = mask_[col];
+      if (m == 0) continue;
+      const double x = (static_cast<double>(cx) + 0.5) * res_;
+      const double y = (static_cast<double>(cy) + 0.5) * res_;
+      if ((x - mean.x) * (x - mean.x) + (y - mean.y) * (y - mean.y) > reach2) continue;
+      auto age_of = [&](int k) {
+        return static_cast<uint16_t>(
+            stamp - stamp_[col * static_cast<size_t>(nz_) + static_cast<size_t>(k)]);
+      };
+      uint64_t through = 0;
+      uint64_t above = 0;
+      uint64_t hidden = 0;    // in view behind something, and older than hidden_decay_s
+      bool standing = false;  // marked by this scan, or a beam beside a voxel ends at it
+      while (m != 0) {
+        const int k = std::countr_zero(m);
+        m &= m - 1;
+        if (age_of(k) == 0) {
+          standing = true;
+          continue;
+        }
+        switch (visibility(mean, x, y, cfg_.z_min_m + (k + 0.5) * res_)) {
+          case Visibility::kSeenThrough:
+            through |= uint64_t{1} << k;
+            break;
+          case Visibility::kAboveView:
+            above |= uint64_t{1} << k;
+            break;
+          case Visibility::kHidden:
+            // In view but behind something nearer: not seen since it was marked. It fades
+            // faster than what is out of view (the frustum acceleration of the spatio-temporal
+            // voxel layer): a pedestrian's trail in the followed person's shadow is gone before
+            // the robot gets there, while what is really there is marked again when it shows.
+            if (age_of(k) > hidden_max_age) hidden |= uint64_t{1} << k;
+            break;
+          case Visibility::kBlocked:
+            standing = true;
+            break;
+          case Visibility::kUnseen:
+            break;
+        }
+      }
+      // What stands on the ground goes with its part in view, above the beams too (a
+      // pedestrian's head, once the robot is close enough that the top beam passes below it):
+      // every layer of the column up to the top beam must be seen through, or hidden (then the
+      // voxels above fade after hidden_decay_s as well).
+      uint64_t freed = through | hidden;
+      if (!standing && above != 0) {
+        bool clear_below = true;
+        bool hidden_below = false;
+        for (int k = 0; k < nz_ && clear_below; ++k) {
+          const Visibility v = visibility(mean, x, y, cfg_.z_min_m + (k + 0.5) * res_);
+          if (v == Visibility::kAboveView) break;
+          hidden_below = hidden_below || v == Visibility::kHidden;
+          clear_below = v == Visibility::kSeenThrough || v == Visibility::kHidden;
+        }
+        for (uint64_t a = above; clear_below && a != 0; a &= a - 1) {
+          const int k = std::countr_zero(a);
+          if (!hidden_below) {
+            freed |= uint64_t{1} << k;
+          } else if (age_of(k) > hidden_max_age) {
+            hidden |= uint64_t{1} << k;
+            freed |= uint64_t{1} << k;
+          }
+        }
+      }
+      if (freed != 0) {
+        stats_.hidden_decayed += static_cast<uint64_t>(std::popcount(hidden));
+        stats_.seen_through += static_cast<uint64_t>(std::popcount(freed & ~hidden));
+        set_column(col, mask_[col] & ~freed);
+      }
+    }
+  }
+}
+
+VoxelGrid::Visibility VoxelGrid::visibility(const Point3& origin, double x, double y,
+                                            double z) const {
+  auto azimuth_bin = [](double dx, double dy) {
+    return static_cast<int>(floor_to_int((std::atan2(dy, dx) + kPi) / kAzimuthBinRad)) %
+           kAzimuthBins;
+  };
+  // The bin from the scan's mean origin, then again from where the sensor was at that azimuth.
+  int ai = azimuth_bin(x - origin.x, y - origin.y);
+  const Point3& o = azimuth_origin_[static_cast<size_t>(ai)];
+  const double dx = x - o.x, dy = y - o.y, dz = z - o.z;
+  ai = azimuth_bin(dx, dy);
+  const double h = std::hypot(dx, dy);
+  const double el = std::atan2(dz, h);
+  const auto range = static_cast<float>(std::hypot(h, dz));
+  const auto margin = static_cast<float>(cfg_.seen_through_margin_m);
+  const auto e0 = static_cast<int>(floor_to_int(el / kElevationBinRad)) + kElevationBins / 2;
+  const bool above_view = el > cfg_.view_top_rad + 0.5 * kElevationBinRad;
+  if (e0 < 0 || (!above_view && e0 >= kElevationBins)) return Visibility::kUnseen;
+  // Where did the nearest beams end, at or below the voxel and at or above it (within the beam
+  // spacing), in its azimuth bin and the two beside it? Above the sensor's view: the top beam,
+  // and whether it passed beyond the column.
+  int through = 0, before = 0, beams = 0;
+  bool all_found = true;
+  auto classify = [&](float end_m, float at_m) {
+    ++beams;
+    if (end_m > at_m + margin) {
+      ++through;
+    } else if (end_m < at_m - margin) {
+      ++before;
+    }
+  };
+  for (int da = -1; da <= 1; ++da) {
+    const int a = (ai + da + kAzimuthBins) % kAzimuthBins;
+    const float* column = &depth_[static_cast<size_t>(a * kElevationBins)];
+    if (above_view) {
+      int top = std::min(e0, kElevationBins - 1);
+      while (top >= 0 && column[top] < 0.0f)
+        --top;
+      if (top < 0) return Visibility::kUnseen;
+      const double top_el = (top - kElevationBins / 2 + 0.5) * kElevationBinRad;
+      classify(static_cast<float>(static_cast<double>(column[top]) * std::cos(top_el)),
+               static_cast<float>(h));
+      continue;
+    }
+    bool below = false;
+    for (int e = e0; e >= 0 && e > e0 - kElevationSearchBins && !below; --e) {
+      if (column[e] < 0.0f) continue;
+      classify(column[e], range);
+      below = true;
+    }
+    bool above = false;
+    for (int e = e0; e < kElevationBins && e < e0 + kElevationSearchBins && !above; ++e) {
+      if (column[e] < 0.0f) continue;
+      classify(column[e], range);
+      above = true;
+    }
+    all_found = all_found && below && above;
+  }
+  if (through + before < beams) return Visibility::kBlocked;  // a beam ended at it: it is there
+  if (above_view) return Visibility::kAboveView;              // its column's layers in view decide
+  if (all_found && through == beams) return Visibility::kSeenThrough;
+  if (all_found && before == beams) return Visibility::kHidden;
+  return beams > 0 ? Visibility::kBlocked : Visibility::kUnseen;  // partly hidden: an edge
 }
 
 void VoxelGrid::decay(Nanos now) {
@@ -342,7 +566,8 @@ bool VoxelGrid::occupied(double x, double y, double z) const {
 size_t VoxelGrid::memory_bytes() const {
   return mask_.capacity() * sizeof(uint64_t) + stamp_.capacity() * sizeof(uint16_t) +
          block_count_.capacity() * sizeof(uint16_t) + traced_.capacity() * sizeof(uint64_t) +
-         traced_scan_.capacity() * sizeof(uint32_t);
+         traced_scan_.capacity() * sizeof(uint32_t) + depth_.capacity() * sizeof(float) +
+         azimuth_origin_.capacity() * sizeof(Point3) + azimuth_seen_.capacity();
 }
 
 size_t VoxelGrid::occupied_count() const {

@@ -149,6 +149,28 @@ std::vector<FieldSpec> build() {
        0,
        0,
        {}},
+      {"costmap.clear_seen_through",
+       "bool",
+       "A voxel the scan did not mark is freed when the scan's beams beside it and just above "
+       "and below it all reached farther: it was seen through (the spatio-temporal voxel "
+       "layer's frustum clearing, but occlusion-aware). Ray casting alone frees only the heights "
+       "a beam crosses; from a moving robot a walking pedestrian then leaves a trail of "
+       "obstacles for decay_s behind them.",
+       FIELD(costmap.clear_seen_through),
+       0,
+       0,
+       {}},
+      {"costmap.hidden_decay_s",
+       "s",
+       "With clear_seen_through: a voxel in view but hidden behind something nearer (every "
+       "beam beside it ended before it) is freed after this long, instead of decay_s (the "
+       "spatio-temporal voxel layer's frustum acceleration). What a pedestrian left in the "
+       "followed person's shadow is then gone before the robot gets there; what is really "
+       "there is marked again as soon as it shows.",
+       FIELD(costmap.hidden_decay_s),
+       0.1,
+       300.0,
+       {}},
       {"costmap.inscribed_radius_m",
        "m",
        "Robot's inscribed radius: cells closer than this to an obstacle are lethal (100).",

@@ -68,7 +68,9 @@ SimRunResult run_simulation(const SimRunOptions& o) {
 
   hal::SimClock clock;
   hal::SystemdNotifier notifier;  // no NOTIFY_SOCKET in a simulation: a no-op
-  SimWorld world(o.scenario, world_config(o.config, o.seed), clock);
+  SimWorldConfig world_cfg = world_config(o.config, o.seed);
+  world_cfg.person_avoids_robot = o.person_avoids_robot;
+  SimWorld world(o.scenario, world_cfg, clock);
   firmware::DaemonConfig cfg = o.config;
   cfg.mppi.seed = o.seed;
   firmware::Daemon daemon(cfg, notifier);

@@ -119,10 +119,79 @@ core::Pose2 SimWorld::robot_at(hal::Nanos t) const {
   return core::interpolate(prev_robot_, now, s);
 }
 
+void SimWorld::move_person(double t_s, double dt_s) {
+  const core::Pose2 scripted = scenario_.person.pose_at(t_s);
+  if (!config_.person_avoids_robot || dt_s <= 0) {
+    person_ = scripted;
+    person_offset_ = {};
+    person_velocity_ = scenario_.person.velocity_at(t_s);
+    return;
+  }
+  const Point2 from{person_.x_m, person_.y_m};
+  // Back toward the path, at most person_return_mps.
+  Point2 offset = person_offset_;
+  const double off_m = std::hypot(offset.x_m, offset.y_m);
+  if (off_m > 0) {
+    const double keep = std::max(off_m - config_.person_return_mps * dt_s, 0.0) / off_m;
+    offset = {offset.x_m * keep, offset.y_m * keep};
+  }
+  Point2 to{scripted.x_m + offset.x_m, scripted.y_m + offset.y_m};
+  const double r = scenario_.person_radius_m;
+  const double margin = config_.person_contact_margin_m;
+  const double gap_from = footprint_distance(from) - r;
+  const double gap_to = footprint_distance(to) - r;
+  if (gap_to < margin && gap_to < gap_from) {
+    // The outward normal of the footprint at the person (base_link's box, then the world).
+    const core::Pose2 robot = robot_pose();
+    const Point2 q = robot.inverse().apply(from);
+    const Point2 c{std::clamp(q.x_m, config_.footprint_x_min_m, config_.footprint_x_max_m),
+                   std::clamp(q.y_m, config_.footprint_y_min_m, config_.footprint_y_max_m)};
+    double nx = q.x_m - c.x_m, ny = q.y_m - c.y_m;
+    double n_len = std::hypot(nx, ny);
+    if (n_len < 1e-9) {  // inside (the robot drove into them): away from its centre
+      nx = q.x_m;
+      ny = q.y_m;
+      n_len = std::max(std::hypot(nx, ny), 1e-9);
+    }
+    const Point2 n = robot.rotate({nx / n_len, ny / n_len});
+    Point2 step{to.x_m - from.x_m, to.y_m - from.y_m};
+    const double into = step.x_m * n.x_m + step.y_m * n.y_m;
+    if (into < 0) {
+      // Around the robot along its side, the way they walk (their heading, not the step: their
+      // path pulls them back toward the robot's middle, and they would dither in front of it);
+      // facing a side square on, past the side of its centre they are on (their right when
+      // straight at it); at least at 0.7 of their pace.
+      const Point2 heading{std::cos(scripted.theta_rad), std::sin(scripted.theta_rad)};
+      Point2 t{-n.y_m, n.x_m};
+      const double forward = t.x_m * heading.x_m + t.y_m * heading.y_m;
+      const double left_of_centre =
+          heading.x_m * (from.y_m - robot.y_m) - heading.y_m * (from.x_m - robot.x_m);
+      constexpr double kSquareOn = 0.05;  // |cos| of the side to the heading
+      const double t_left = -t.x_m * heading.y_m + t.y_m * heading.x_m;  // t . (their left)
+      const bool flip =
+          std::abs(forward) > kSquareOn ? forward < 0 : (left_of_centre > 1e-9) != (t_left > 0);
+      if (flip) t = {-t.x_m, -t.y_m};
+      const double len = std::hypot(step.x_m, step.y_m);
+      const double along = std::max(step.x_m * t.x_m + step.y_m * t.y_m, 0.7 * len);
+      step = {along * t.x_m, along * t.y_m};
+    }
+    to = {from.x_m + step.x_m, from.y_m + step.y_m};
+    // Nor into a wall while sliding, nor closer to the robot than they were.
+    const double wall_to = scenario_.world.distance(to);
+    constexpr double kSlideToleranceM = 1e-6;  // sliding along a side keeps the gap, to rounding
+    if (footprint_distance(to) - r < std::min(margin, gap_from) - kSlideToleranceM ||
+        (wall_to < r && wall_to < scenario_.world.distance(from))) {
+      to = from;
+    }
+  }
+  person_offset_ = {to.x_m - scripted.x_m, to.y_m - scripted.y_m};
+  person_velocity_ = {(to.x_m - from.x_m) / dt_s, (to.y_m - from.y_m) / dt_s};
+  person_ = {to.x_m, to.y_m, scripted.theta_rad};
+}
+
 void SimWorld::advance(double t_s) {
   const double dt = t_s - t_s_;
-  person_ = scenario_.person.pose_at(t_s);
-  person_velocity_ = scenario_.person.velocity_at(t_s);
+  move_person(t_s, dt);
   if (dt > 0) {
     const core::Pose2 robot = robot_pose();
     const auto& v = base_->velocity();

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <random>
 
 #include "core/perception/costmap.hpp"
@@ -123,6 +124,22 @@ TEST(VoxelGrid, PersonMaskCoversWhereThePersonWalkedDuringTheScan) {
   EXPECT_TRUE(g.occupied(5.0, 7.2, 1.0));
 }
 
+TEST(VoxelGrid, WhereThePersonWalksIsFreedOfWhatWasLeftThere) {
+  // Someone stood at (7, 5), then left unseen (in the shadow of the followed person, say); the
+  // followed person now walks through that place: it is freed, and nothing 1 m away is.
+  core::VoxelGrid g(small_grid());
+  g.recentre(5, 5);
+  const Point3 origin{5, 5, 0.5};
+  g.insert(std::vector<Ray>{ray_to(7.0, 5.0, 0.5, origin), ray_to(7.0, 6.0, 0.5, origin)},
+           core::Pose2{5, 5, 0}, std::nullopt, 1s);
+  ASSERT_EQ(g.occupied_count(), 2U);
+  g.insert(std::vector<Ray>{}, core::Pose2{5, 5, 0}, core::PersonSweep{{6.8, 4.9}, {7.1, 5.0}},
+           1100ms);
+  EXPECT_FALSE(g.occupied(7.0, 5.0, 0.5));
+  EXPECT_TRUE(g.occupied(7.0, 6.0, 0.5));
+  EXPECT_EQ(g.stats().person_cleared, 1U);
+}
+
 TEST(VoxelGrid, BeamsWithoutAReturnClearTheWholeWayAndMarkNothing) {
   // A pedestrian stood at (7, 5); they walked on and nothing stands behind that place: the beam
   // that hit them now returns nothing. Its no-return ray must clear their voxel (otherwise it
@@ -187,7 +204,7 @@ TEST(VoxelGrid, MemoryDoesNotGrowAndDecayedVoxelsAreFreed) {
   EXPECT_EQ(g.memory_bytes(), bytes);
   // At most decay_s (2 s = 20 scans) of marks survive: bounded by 20 x 500.
   EXPECT_LE(max_occupied, 20U * 500U);
-  EXPECT_GT(g.stats().decayed + g.stats().cleared, g.stats().marked / 2)
+  EXPECT_GT(g.stats().decayed + g.stats().cleared + g.stats().seen_through, g.stats().marked / 2)
       << "marks are freed (by rays and by age; the rest left the window), not hidden";
 }
 
@@ -212,6 +229,123 @@ TEST(VoxelGrid, AWalkingPersonLeavesNoTrail) {
   EXPECT_FALSE(g.occupied(2.0, -1.5 * 2.0 / 3.5, 0.5));
   EXPECT_TRUE(g.occupied(3.5, -1.5, 0.5));
   EXPECT_TRUE(g.occupied(2.0, 1.5 * 2.0 / 3.5, 0.5)) << "where it is now";
+}
+
+// A VLP-16-like revolution (16 beams, -15..15 degrees, every 0.2 degrees of azimuth within
+// +-60 degrees) from `origin` into a scene of standing cylinders (1.75 m tall), a wall at
+// x = wall_x_m and the ground; beams that hit nothing within 8 m return no-return rays.
+struct Cylinder {
+  double x, y, r;
+};
+std::vector<Ray> revolution(const Point3& origin, const std::vector<Cylinder>& people,
+                            double wall_x_m) {
+  std::vector<Ray> rays;
+  constexpr double kMax = 8.0;
+  for (double az_deg = -60.0; az_deg <= 60.0; az_deg += 0.2) {
+    const double az = az_deg * std::numbers::pi / 180.0;
+    for (int b = 0; b < 16; ++b) {
+      const double el = (-15.0 + 2.0 * b) * std::numbers::pi / 180.0;
+      const double dx = std::cos(az) * std::cos(el);
+      const double dy = std::sin(az) * std::cos(el);
+      const double dz = std::sin(el);
+      double t = kMax;
+      if (dz < 0) t = std::min(t, -origin.z / dz);  // the ground
+      if (dx > 1e-9) {
+        const double tw = (wall_x_m - origin.x) / dx;
+        if (tw > 0 && origin.z + tw * dz < 2.5) t = std::min(t, tw);
+      }
+      for (const Cylinder& c : people) {
+        // Horizontal ray-circle, then the cylinder's height.
+        const double h = std::hypot(dx, dy);
+        const double ux = dx / h, uy = dy / h;
+        const double px = origin.x - c.x, py = origin.y - c.y;
+        const double bq = px * ux + py * uy;
+        const double disc = bq * bq - (px * px + py * py - c.r * c.r);
+        if (disc < 0) continue;
+        const double s = -bq - std::sqrt(disc);  // horizontal distance to the surface
+        if (s <= 0) continue;
+        const double tc = s / h;
+        if (origin.z + tc * dz < 1.75) t = std::min(t, tc);
+      }
+      Ray r{origin, Point3{origin.x + t * dx, origin.y + t * dy, origin.z + t * dz}};
+      r.hit = t < kMax;
+      rays.push_back(r);
+    }
+  }
+  return rays;
+}
+
+// A pedestrian crosses 3 m ahead of a robot that drives on at 1 m/s; a wall stands at 5 m.
+// Returns whether the place the pedestrian started from is still an obstacle after 1.5 s.
+bool trail_left(bool clear_seen_through, bool* wall_kept) {
+  auto cfg = small_grid();
+  cfg.size_xy_m = 12.0;
+  cfg.resolution_m = 0.05;
+  cfg.clear_max_range_m = 8.0;
+  cfg.clear_seen_through = clear_seen_through;
+  core::VoxelGrid g(cfg);
+  for (int scan = 0; scan <= 15; ++scan) {
+    const double x = 0.1 * scan;
+    g.recentre(x, 0.0);
+    const std::vector<Cylinder> people{{3.0, -1.0 + 0.12 * scan, 0.25}};
+    const Nanos now = std::chrono::milliseconds(100 * scan);
+    g.insert(revolution(Point3{x, 0.0, 0.45}, people, 5.0), core::Pose2{x, 0, 0}, std::nullopt,
+             now);
+    g.decay(now);
+  }
+  *wall_kept = false;
+  for (double z = 0.1; z < 1.0; z += 0.05)
+    *wall_kept = *wall_kept || g.occupied(5.01, 0.0, z) || g.occupied(4.99, 0.0, z);
+  bool trail = false;
+  for (double z = 0.1; z < 1.75; z += 0.05) {
+    for (double y = -1.3; y <= -0.7; y += 0.05)
+      trail = trail || g.occupied(2.76, y, z) || g.occupied(2.81, y, z);
+  }
+  return trail;
+}
+
+TEST(VoxelGrid, FromAMovingRobotWhatWasSeenThroughIsFreedAndWallsStay) {
+  // The beams of a moving sensor cross a vacated place at other heights than those that marked
+  // it: ray casting alone leaves a trail for decay_s.
+  bool wall = false;
+  EXPECT_TRUE(trail_left(false, &wall)) << "the premise: ray casting alone leaves the trail";
+  EXPECT_TRUE(wall);
+  EXPECT_FALSE(trail_left(true, &wall)) << "the beams beside those voxels passed beyond them";
+  EXPECT_TRUE(wall) << "a wall the beams hit at other heights each scan is not seen through";
+}
+
+TEST(VoxelGrid, WhatIsHiddenBehindSomeoneFadesAfterHiddenDecayNotBefore) {
+  // A post 5 m ahead, then someone steps in front of it (3 m ahead) and stays: the post is not
+  // seen through; it stays for hidden_decay_s (0.5 s), then fades (in view but not seen: the
+  // frustum acceleration of the spatio-temporal voxel layer), well before decay_s (2 s).
+  auto cfg = small_grid();
+  cfg.size_xy_m = 12.0;
+  cfg.resolution_m = 0.05;
+  cfg.clear_max_range_m = 8.0;
+  cfg.hidden_decay_s = 0.5;
+  core::VoxelGrid g(cfg);
+  g.recentre(0, 0);
+  const Point3 sensor{0.0, 0.0, 0.45};
+  auto post = [&] {
+    bool any = false;
+    for (double z = 0.1; z < 1.0; z += 0.05)
+      any = any || g.occupied(4.92, 0.0, z);
+    return any;
+  };
+  g.insert(revolution(sensor, {{5.0, 0.0, 0.1}}, 50.0), {}, std::nullopt, 0ms);
+  ASSERT_TRUE(post());
+  for (int scan = 1; scan <= 15; ++scan) {
+    const Nanos now = std::chrono::milliseconds(100 * scan);
+    g.insert(revolution(sensor, {{5.0, 0.0, 0.1}, {3.0, 0.0, 0.3}}, 50.0), {}, std::nullopt, now);
+    g.decay(now);
+    if (scan == 4) {
+      EXPECT_TRUE(post()) << "hidden for 0.4 s: kept";
+    }
+  }
+  EXPECT_FALSE(post()) << "hidden for 1.5 s: faded";
+  EXPECT_EQ(g.stats().seen_through, 0U);
+  EXPECT_GT(g.stats().hidden_decayed, 0U);
+  EXPECT_EQ(g.stats().decayed, 0U);
 }
 
 // ---- costmap -----------------------------------------------------------------------------------

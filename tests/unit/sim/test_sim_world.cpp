@@ -370,6 +370,32 @@ TEST(SimWorld, TrackerFramesPlaceThePersonWhereTheWorldHasThem) {
   EXPECT_NEAR(frames, 60, 1) << "120 Hz";
 }
 
+TEST(SimWorld, ThePersonDoesNotWalkIntoAStandingRobotButPastItAndBackOntoTheirPath) {
+  // The robot stands on the person's scripted line (no commands: the base stays put).
+  sim::Scenario s;
+  s.name = "t";
+  s.person = sim::walk({{{0.0, 0.0}}, {{5.0, 0.0}, 1.0}}, 0.0);
+  s.robot_start = Pose2{2.0, 0.0, 0.0};
+  auto min_clearance = [&](bool avoids, Pose2* end) {
+    hal::SimClock clock;
+    sim::SimWorldConfig cfg;
+    cfg.person_avoids_robot = avoids;
+    sim::SimWorld world(s, cfg, clock);
+    double least = 1e9;
+    for (int ms = 0; ms <= 9000; ms += 5) {
+      world.step(std::chrono::milliseconds(ms));
+      least = std::min(least, world.footprint_clearance_people());
+    }
+    *end = world.person_pose();
+    return least;
+  };
+  Pose2 end;
+  EXPECT_GT(min_clearance(true, &end), 0.04) << "kept the contact margin (0.05 m)";
+  EXPECT_NEAR(end.x_m, 5.0, 0.02) << "back on the script's end point";
+  EXPECT_NEAR(end.y_m, 0.0, 0.02);
+  EXPECT_EQ(min_clearance(false, &end), 0.0) << "the scripted walk alone goes through the robot";
+}
+
 // ---- the in-process datagram link ---------------------------------------------------------------
 
 TEST(DatagramQueue, DeliversWhatHasArrivedByNowAndCountsOverflow) {

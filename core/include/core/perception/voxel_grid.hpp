@@ -29,6 +29,16 @@ struct VoxelGridConfig {
   double z_max_m = 2.0;   // above: overhead (not marked); at most 64 voxels in the band
   double decay_s = 5.0;
   double clear_max_range_m = 10.0;  // rays are cleared up to this far from the sensor
+  // A voxel this scan did not mark is freed when the scan's beams next to it (in azimuth, and
+  // just above and below it) all reached at least this much farther: it was seen through.
+  bool clear_seen_through = true;
+  double seen_through_margin_m = 0.15;
+  // A voxel in view but hidden behind something nearer is freed after this long (the rest after
+  // decay_s).
+  double hidden_decay_s = 0.5;
+  // The sensor's highest beam above its horizontal (VLP-16: 15 degrees): what is above it is out
+  // of view, however near.
+  double view_top_rad = 15.0 * 3.14159265358979323846 / 180.0;
   // Self filter: the robot's body in base_link (returns inside are not obstacles).
   double footprint_x_min_m = -0.35, footprint_x_max_m = 0.35;
   double footprint_y_min_m = -0.30, footprint_y_max_m = 0.30;
@@ -53,12 +63,15 @@ struct VoxelGridStats {
   uint64_t marked = 0;
   uint64_t self_filtered = 0;
   uint64_t person_masked = 0;
-  uint64_t out_of_band = 0;    // ground / overhead
-  uint64_t out_of_window = 0;  // end point outside the window (the ray still clears)
-  uint64_t cleared = 0;        // voxels freed by rays
-  uint64_t no_return = 0;      // rays of beams without a return (clear only)
-  uint64_t rays_traced = 0;    // rays cast for clearing (one per end voxel and scan)
-  uint64_t decayed = 0;        // voxels freed by age
+  uint64_t out_of_band = 0;     // ground / overhead
+  uint64_t out_of_window = 0;   // end point outside the window (the ray still clears)
+  uint64_t cleared = 0;         // voxels freed by rays
+  uint64_t no_return = 0;       // rays of beams without a return (clear only)
+  uint64_t rays_traced = 0;     // rays cast for clearing (one per end voxel and scan)
+  uint64_t decayed = 0;         // voxels freed by age
+  uint64_t seen_through = 0;    // voxels freed because the scan's beams passed beyond them
+  uint64_t person_cleared = 0;  // voxels freed where the tracked person stands
+  uint64_t hidden_decayed = 0;  // voxels freed after hidden_decay_s behind something nearer
 };
 
 // Where the tracked person was while the scan was taken (odom): from the scan's first return to
@@ -78,7 +91,8 @@ class VoxelGrid {
   void recentre(double robot_x_m, double robot_y_m);
   // Marks and clears with one scan's rays. `robot` is the base pose in odom for the self filter
   // (the scan is short: one pose is accurate to a few cm), `person` the tracked person (odom):
-  // returns within person_mask_radius_m of the swept segment are not marked.
+  // returns within person_mask_radius_m of the swept segment are not marked, and voxels there
+  // are freed (where the person stands, nothing else does).
   void insert(std::span<const Ray> rays, const Pose2& robot, std::optional<PersonSweep> person,
               Nanos now);
   // Frees voxels older than decay_s.
@@ -101,6 +115,13 @@ class VoxelGrid {
  private:
   [[nodiscard]] size_t slot(int64_t cx, int64_t cy) const;  // odom cell -> storage column
   void clear_ray(const Ray& r, int64_t end_cx, int64_t end_cy, int end_cz);
+  void clear_seen_through(std::span<const Ray> rays, uint16_t stamp);
+  void clear_person(const PersonSweep& person);
+  // How this scan saw the point (odom) from `origin`: the beams beside it (above and below it)
+  // all passed beyond it, one ended at it, all ended before it (hidden), it is above the highest
+  // beam there (and the beams below passed beyond), or no beam came near it.
+  enum class Visibility { kSeenThrough, kBlocked, kHidden, kAboveView, kUnseen };
+  [[nodiscard]] Visibility visibility(const Point3& origin, double x, double y, double z) const;
   void empty_column(size_t col);
   void set_column(size_t col, uint64_t mask);  // keeps the block counts
   [[nodiscard]] size_t block_of(size_t col) const;
@@ -122,6 +143,13 @@ class VoxelGrid {
   std::vector<uint64_t> traced_;
   std::vector<uint32_t> traced_scan_;
   uint32_t scan_serial_ = 0;
+  // The scan's depth image (nearest range per azimuth x elevation bin, < 0: no beam) and the
+  // sensor's origin per azimuth bin (it moves during a revolution).
+  static constexpr int kAzimuthBins = 720;   // 0.5 degree
+  static constexpr int kElevationBins = 90;  // 1 degree, -45..45 degrees
+  std::vector<float> depth_;
+  std::vector<Point3> azimuth_origin_;
+  std::vector<uint8_t> azimuth_seen_;  // this scan has a ray in the bin
   VoxelGridStats stats_;
 };
 

@@ -47,6 +47,8 @@ struct DaemonConfig {
     double decay_s = 0;
     double clear_max_range_m = 0;
     bool clear_on_no_return = false;
+    bool clear_seen_through = false;
+    double hidden_decay_s = 0;
     double inscribed_radius_m = 0;
     double inflation_radius_m = 0;
     double cost_scaling_per_m = 0;

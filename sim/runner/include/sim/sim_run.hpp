@@ -32,8 +32,9 @@ struct SimRunOptions {
   double duration_s = 0;  // 0: the scenario's
   // Called every world step (5 ms) before the world advances: fault injection, observation.
   std::function<void(double t_s, SimWorld& world, firmware::Daemon& daemon)> script;
-  bool capture_can = false;  // keep every CAN frame the daemon sends
-  bool quiet = true;         // daemon logs at warning level and above only
+  bool capture_can = false;         // keep every CAN frame the daemon sends
+  bool quiet = true;                // daemon logs at warning level and above only
+  bool person_avoids_robot = true;  // SimWorldConfig::person_avoids_robot
 };
 
 struct SimRunResult {

@@ -30,6 +30,14 @@ struct SimWorldConfig {
   double footprint_x_min_m = -0.35, footprint_x_max_m = 0.35;
   double footprint_y_min_m = -0.30, footprint_y_max_m = 0.30;
   double robot_avoid_radius_m = 0.45;  // how pedestrians see the robot (social force)
+  // The followed person walks their script but does not walk into the robot (as nobody walks
+  // into a robot standing in their way): a step that would bring them closer than
+  // person_contact_margin_m to its footprint keeps only its part along the footprint (they slide
+  // past it), and once clear they drift back onto their path at person_return_mps. A contact the
+  // robot causes by driving into the person still counts. Off: the person walks through it.
+  bool person_avoids_robot = true;
+  double person_contact_margin_m = 0.05;
+  double person_return_mps = 0.5;
 };
 
 // Everything true at one instant, for metrics, reports and pictures.
@@ -82,6 +90,7 @@ class SimWorld {
 
  private:
   void advance(double t_s);
+  void move_person(double t_s, double dt_s);
   void update_tracker_pose();
   [[nodiscard]] double footprint_distance(const Point2& p) const;  // point to footprint (world)
   [[nodiscard]] core::Pose2 robot_at(hal::Nanos t) const;
@@ -110,6 +119,7 @@ class SimWorld {
   hal::Nanos prev_robot_time_{0};
   core::Pose2 person_;
   Point2 person_velocity_;
+  Point2 person_offset_;             // where the person is, minus where their script has them
   std::vector<Cylinder> cylinders_;  // scratch
   std::vector<MovingBody> bodies_;   // scratch
 };
