@@ -369,7 +369,7 @@ void VoxelGrid::clear_seen_through(std::span<const Ray> rays, uint16_t stamp) {
     if (ei < 0 || ei >= kElevationBins) continue;
     const auto ai =
         static_cast<int>(floor_to_int((std::atan2(vy, vx) + kPi) / kAzimuthBinRad)) % kAzimuthBins;
-    float& d = depth_[static_cast<size_t>(ai * kElevationBins + ei)];
+    float& d = depth_[static_cast<size_t>(ai) * kElevationBins + static_cast<size_t>(ei)];
     const auto range = static_cast<float>(std::hypot(h, vz));
     if (azimuth_seen_[static_cast<size_t>(ai)] == 0) {
       azimuth_seen_[static_cast<size_t>(ai)] = 1;
@@ -496,13 +496,14 @@ VoxelGrid::Visibility VoxelGrid::visibility(const Point3& origin, double x, doub
   };
   for (int da = -1; da <= 1; ++da) {
     const int a = (ai + da + kAzimuthBins) % kAzimuthBins;
-    const float* column = &depth_[static_cast<size_t>(a * kElevationBins)];
+    const float* column = &depth_[static_cast<size_t>(a) * kElevationBins];
     if (above_view) {
       int top = std::min(e0, kElevationBins - 1);
       while (top >= 0 && column[top] < 0.0f)
         --top;
       if (top < 0) return Visibility::kUnseen;
-      const double top_el = (top - kElevationBins / 2 + 0.5) * kElevationBinRad;
+      const int above_horizon = top - kElevationBins / 2;  // bins
+      const double top_el = (above_horizon + 0.5) * kElevationBinRad;
       classify(static_cast<float>(static_cast<double>(column[top]) * std::cos(top_el)),
                static_cast<float>(h));
       continue;
