@@ -394,6 +394,7 @@ void VoxelGrid::clear_seen_through(std::span<const Ray> rays, uint16_t stamp) {
       const double x = (static_cast<double>(cx) + 0.5) * res_;
       const double y = (static_cast<double>(cy) + 0.5) * res_;
       if ((x - mean.x) * (x - mean.x) + (y - mean.y) * (y - mean.y) > reach2) continue;
+      const ColumnView view = column_view(mean, x, y);
       auto age_of = [&](int k) {
         return static_cast<uint16_t>(
             stamp - stamp_[col * static_cast<size_t>(nz_) + static_cast<size_t>(k)]);
@@ -409,7 +410,7 @@ void VoxelGrid::clear_seen_through(std::span<const Ray> rays, uint16_t stamp) {
           standing = true;
           continue;
         }
-        switch (visibility(mean, x, y, cfg_.z_min_m + (k + 0.5) * res_)) {
+        switch (visibility(view, cfg_.z_min_m + (k + 0.5) * res_)) {
           case Visibility::kSeenThrough:
             through |= uint64_t{1} << k;
             break;
@@ -439,7 +440,7 @@ void VoxelGrid::clear_seen_through(std::span<const Ray> rays, uint16_t stamp) {
         bool clear_below = true;
         bool hidden_below = false;
         for (int k = 0; k < nz_ && clear_below; ++k) {
-          const Visibility v = visibility(mean, x, y, cfg_.z_min_m + (k + 0.5) * res_);
+          const Visibility v = visibility(view, cfg_.z_min_m + (k + 0.5) * res_);
           if (v == Visibility::kAboveView) break;
           hidden_below = hidden_below || v == Visibility::kHidden;
           clear_below = v == Visibility::kSeenThrough || v == Visibility::kHidden;
@@ -463,18 +464,22 @@ void VoxelGrid::clear_seen_through(std::span<const Ray> rays, uint16_t stamp) {
   }
 }
 
-VoxelGrid::Visibility VoxelGrid::visibility(const Point3& origin, double x, double y,
-                                            double z) const {
-  auto azimuth_bin = [](double dx, double dy) {
+VoxelGrid::ColumnView VoxelGrid::column_view(const Point3& origin, double x, double y) const {
+  auto azimuth_bin_of = [](double dx, double dy) {
     return static_cast<int>(floor_to_int((std::atan2(dy, dx) + kPi) / kAzimuthBinRad)) %
            kAzimuthBins;
   };
   // The bin from the scan's mean origin, then again from where the sensor was at that azimuth.
-  int ai = azimuth_bin(x - origin.x, y - origin.y);
-  const Point3& o = azimuth_origin_[static_cast<size_t>(ai)];
-  const double dx = x - o.x, dy = y - o.y, dz = z - o.z;
-  ai = azimuth_bin(dx, dy);
-  const double h = std::hypot(dx, dy);
+  const Point3& o =
+      azimuth_origin_[static_cast<size_t>(azimuth_bin_of(x - origin.x, y - origin.y))];
+  const double dx = x - o.x, dy = y - o.y;
+  return {azimuth_bin_of(dx, dy), std::hypot(dx, dy), o.z};
+}
+
+VoxelGrid::Visibility VoxelGrid::visibility(const ColumnView& view, double z) const {
+  const int ai = view.azimuth_bin;
+  const double h = view.horizontal_m;
+  const double dz = z - view.sensor_z_m;
   const double el = std::atan2(dz, h);
   const auto range = static_cast<float>(std::hypot(h, dz));
   const auto margin = static_cast<float>(cfg_.seen_through_margin_m);

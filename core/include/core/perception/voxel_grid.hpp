@@ -121,7 +121,15 @@ class VoxelGrid {
   // all passed beyond it, one ended at it, all ended before it (hidden), it is above the highest
   // beam there (and the beams below passed beyond), or no beam came near it.
   enum class Visibility { kSeenThrough, kBlocked, kHidden, kAboveView, kUnseen };
-  [[nodiscard]] Visibility visibility(const Point3& origin, double x, double y, double z) const;
+  // A column as the scan saw it: its azimuth bin from where the sensor was at that azimuth, and
+  // its horizontal distance from there (the same for every voxel of the column).
+  struct ColumnView {
+    int azimuth_bin = 0;
+    double horizontal_m = 0.0;
+    double sensor_z_m = 0.0;
+  };
+  [[nodiscard]] ColumnView column_view(const Point3& origin, double x, double y) const;
+  [[nodiscard]] Visibility visibility(const ColumnView& column, double z) const;
   void empty_column(size_t col);
   void set_column(size_t col, uint64_t mask);  // keeps the block counts
   [[nodiscard]] size_t block_of(size_t col) const;
