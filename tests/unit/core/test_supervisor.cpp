@@ -165,11 +165,11 @@ TEST(Supervisor, PersonTooFarIsPersonLost) {
   h.arm();
   const auto out = h.run(20ms, [&] {
     auto in = h.healthy();
-    in.person_distance_m = 3.5;
+    in.person_distance_m = 5.5;
     return in;
   });
   EXPECT_EQ(out.reason, Reason::kPersonLost);
-  EXPECT_NE(values(h.last_transition_).find("3.50 m > 3.00 m"), std::string::npos);
+  EXPECT_NE(values(h.last_transition_).find("5.50 m > 5.00 m"), std::string::npos);
 }
 
 TEST(Supervisor, StaleCostmapWithLiveLidarIsCostmapStale) {

@@ -441,7 +441,7 @@ TEST(DaemonWithTracker, SilenceAndDistanceReachTheSupervisor) {
         if (now == 2s) w.tracker.set_silent(true);
         if (now == 2500ms) {
           w.tracker.set_silent(false);
-          w.tracker.set_sensor_pose(-3.5, 0.0, 0.0, std::numbers::pi);  // 3.5 m away
+          w.tracker.set_sensor_pose(-5.5, 0.0, 0.0, std::numbers::pi);  // 5.5 m away
         }
         for (Nanos at : {1900ms, 2200ms, 2700ms}) {
           if (now == at) seen[at] = w.daemon.safety().read()->value;

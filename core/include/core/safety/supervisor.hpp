@@ -53,7 +53,10 @@ struct SupervisorConfig {
   Nanos resume_after = std::chrono::milliseconds(1000);  // a HOLD cause clear this long to resume
   Nanos tracker_timeout = std::chrono::milliseconds(100);
   Nanos tracker_confidence_recover = std::chrono::milliseconds(1000);
-  double person_max_distance_m = 3.0;
+  // A companion that falls behind catches up: at 3 m the robot held while the person walked on,
+  // and a lag of a second became a lost person (docs/EVALUATION.md). The tracker's own confidence
+  // gate holds the robot where the signal degrades with range.
+  double person_max_distance_m = 5.0;
   Nanos lidar_timeout = std::chrono::milliseconds(300);
   Nanos costmap_max_age = std::chrono::milliseconds(500);
   Nanos base_feedback_timeout = std::chrono::milliseconds(200);
