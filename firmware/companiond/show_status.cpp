@@ -83,11 +83,15 @@ int show_status(const std::string& path) {
       num(b["feedback_age_ms"], "{:.0f}"), num(b["vx_mps"], "{:+.2f}"), num(b["vy_mps"], "{:+.2f}"),
       num(b["wz_radps"], "{:+.2f}"));
   const json& c = j["control"];
+  const json bc = c.value("best_cost", json::object());
   std::cout << fmt::format(
-      "control  tracking {} runs {} failures {} repairs {} ESS {}, command {} {} {}\n",
+      "control  tracking {} runs {} failures {} repairs {} ESS {}, command {} {} {}\n"
+      "         best plan cost {} = tracking {} + collision {} + barrier {} + control {}\n",
       yes(c["tracking"]), num(c["runs"], "{:.0f}"), num(c["failures"], "{:.0f}"),
       num(c["repairs"], "{:.0f}"), num(c["effective_samples"], "{:.0f}"),
-      num(c["vx_mps"], "{:+.2f}"), num(c["vy_mps"], "{:+.2f}"), num(c["wz_radps"], "{:+.2f}"));
+      num(c["vx_mps"], "{:+.2f}"), num(c["vy_mps"], "{:+.2f}"), num(c["wz_radps"], "{:+.2f}"),
+      num(c["min_cost"], "{:.0f}"), num(bc["tracking"], "{:.0f}"), num(bc["collision"], "{:.0f}"),
+      num(bc["barrier"], "{:.0f}"), num(bc["control"], "{:.0f}"));
   std::cout << fmt::format("{:<11}{:>8}{:>8}{:>11}{:>9}{:>9}{:>9}{:>8}{:>9}{:>8}{:>12}\n", "task",
                            "rate", "nominal", "jitter p99", "run p50", "run p99", "run max",
                            "budget", "overruns", "skipped", "over budget");

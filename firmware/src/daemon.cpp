@@ -575,6 +575,7 @@ bool Daemon::run_controller(Nanos now, core::BodyVelocity& requested) {
   control_state_.repaired = out.repaired;
   if (out.repaired) ++control_state_.repairs;
   control_state_.min_cost = out.min_cost;
+  control_state_.best_cost = out.best;
   control_state_.effective_samples = out.effective_samples;
   requested = core::BodyVelocity{out.command.vx, out.command.vy, out.command.wz};
   return true;

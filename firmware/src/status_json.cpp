@@ -96,6 +96,11 @@ std::string Daemon::build_status_json(core::Nanos now) const {
                     {"repairs", v.repairs},
                     {"effective_samples", number(v.effective_samples)},
                     {"min_cost", number(v.min_cost)},
+                    {"best_cost",
+                     {{"tracking", number(v.best_cost.tracking)},
+                      {"collision", number(v.best_cost.collision)},
+                      {"barrier", number(v.best_cost.barrier)},
+                      {"control", number(v.best_cost.control)}}},
                     {"vx_mps", number(v.command.vx_mps)},
                     {"vy_mps", number(v.command.vy_mps)},
                     {"wz_radps", number(v.command.wz_radps)}};

@@ -35,6 +35,9 @@ Mppi::Mppi(const MppiConfig& config)
       pool_(kPoolSize),
       offset_((static_cast<size_t>(config.samples) + kLanes - 1) / kLanes),
       cost_(offset_.size() * kLanes),
+      tracking_cost_(cost_.size()),
+      collision_cost_(cost_.size()),
+      barrier_cost_(cost_.size()),
       weight_(cost_.size()),
       rng_state_(config.seed * 0x9E3779B97F4A7C15ULL + 1) {
   person_frames_.reserve(static_cast<size_t>(config.horizon_steps) + 1);
@@ -135,6 +138,7 @@ void Mppi::rollout_block(size_t block, const MppiInputs& in) {
     return qx * ex * ex + qy * ey * ey + qt * et * et;
   };
   alignas(32) float x[kL], y[kL], th[kL], c[kL], s[kL], pvx[kL], pvy[kL], pwz[kL], cost[kL], h[kL];
+  alignas(32) float trk[kL], col[kL], bar[kL];  // the terms of cost, for diagnosis
   for (size_t j = 0; j < kL; ++j) {
     x[j] = static_cast<float>(in.robot.x_m);
     y[j] = static_cast<float>(in.robot.y_m);
@@ -146,6 +150,9 @@ void Mppi::rollout_block(size_t block, const MppiInputs& in) {
     pwz[j] = static_cast<float>(in.current.wz);
     cost[j] = 0.0f;
     h[j] = 0.0f;
+    trk[j] = 0.0f;
+    col[j] = 0.0f;
+    bar[j] = 0.0f;
   }
   auto barrier_lanes = [&](size_t k, float* out) {
     const PersonFrame& f = person_frames_[std::min(k, person_frames_.size() - 1)];
@@ -194,17 +201,24 @@ void Mppi::rollout_block(size_t block, const MppiInputs& in) {
       s[j] = s[j] * ca + c[j] * sa;
       c[j] = cn;
       th[j] += a;
-      cost[j] += tracking(x[j], y[j], th[j]);
+      const float track = tracking(x[j], y[j], th[j]);
+      cost[j] += track;
+      trk[j] += track;
     }
     if (with_map) {
       for (size_t j = 0; j < kL; ++j) {
-        if (in.costmap->cost(x[j], y[j]) >= cfg_.cost_threshold) cost[j] += collision;
+        if (in.costmap->cost(x[j], y[j]) >= cfg_.cost_threshold) {
+          cost[j] += collision;
+          col[j] += collision;
+        }
       }
     }
     if (with_person) {
       barrier_lanes(k + 1, hn);
       for (size_t j = 0; j < kL; ++j) {
-        cost[j] += c_safe * std::max(keep * h[j] - hn[j], 0.0f);
+        const float barrier = c_safe * std::max(keep * h[j] - hn[j], 0.0f);
+        cost[j] += barrier;
+        bar[j] += barrier;
         h[j] = hn[j];
       }
     }
@@ -212,7 +226,13 @@ void Mppi::rollout_block(size_t block, const MppiInputs& in) {
   const auto tw = static_cast<float>(cfg_.terminal_weight);
   goal_at(horizon);
   for (size_t j = 0; j < kL; ++j) {
-    cost_[block * kL + j] = static_cast<double>(cost[j] + tw * tracking(x[j], y[j], th[j]));
+    const size_t m = block * kL + j;
+    // The total as one running sum (the terms are kept beside it, not summed into it).
+    const float terminal = tw * tracking(x[j], y[j], th[j]);
+    cost_[m] = static_cast<double>(cost[j] + terminal);
+    tracking_cost_[m] = trk[j] + terminal;
+    collision_cost_[m] = col[j];
+    barrier_cost_[m] = bar[j];
   }
 }
 
@@ -247,12 +267,21 @@ MppiOutput Mppi::step(const MppiInputs& in) {
   for (int64_t b = 0; b < blocks; ++b)
     rollout_block(static_cast<size_t>(b), in);
   double min_cost = std::numeric_limits<double>::infinity();
-  for (const double c : cost_)
-    min_cost = std::min(min_cost, c);
+  size_t best = 0;
+  for (size_t m = 0; m < cost_.size(); ++m) {
+    if (cost_[m] < min_cost) {
+      min_cost = cost_[m];
+      best = m;
+    }
+  }
   if (!std::isfinite(min_cost)) {
     reset();
     return out;  // ok = false, zero command
   }
+  out.best.tracking = static_cast<double>(tracking_cost_[best]);
+  out.best.collision = static_cast<double>(collision_cost_[best]);
+  out.best.barrier = static_cast<double>(barrier_cost_[best]);
+  out.best.control = min_cost - out.best.tracking - out.best.collision - out.best.barrier;
   // Importance weights at temperature lambda; raised (geometrically, then bisected in log space)
   // when fewer than min_effective_samples samples would carry the update.
   auto weigh = [&](double lambda) {

@@ -109,6 +109,7 @@ struct ControlStatus {
   bool numerical_failure = false;  // latched: NaN/Inf from the controller at some run
   bool repaired = false;           // the QP repair changed the first control
   double min_cost = 0;             // the best rollout's cost
+  core::MppiCostTerms best_cost;   // ... by term (why the robot leaves q^d: collision, barrier)
   double effective_samples = 0;
   uint64_t runs = 0;           // MPPI steps so far
   uint64_t failures = 0;       // MPPI steps that failed

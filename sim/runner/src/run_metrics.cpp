@@ -140,6 +140,10 @@ void RunMetricsRecorder::record(double t_s, double dt_s, const core::Pose2& robo
     s.side = view.side;
     s.cmd_vx_mps = view.cmd_vx;
     s.cmd_vy_mps = view.cmd_vy;
+    const double none = std::nan("");
+    s.plan_tracking = view.tracking ? view.plan_tracking : none;
+    s.plan_collision = view.tracking ? view.plan_collision : none;
+    s.plan_barrier = view.tracking ? view.plan_barrier : none;
     samples_.push_back(std::move(s));
     next_sample_s_ = t_s + config_.sample_period_s;
   }

@@ -53,6 +53,12 @@ DaemonView daemon_view(const firmware::Daemon& daemon, const core::Pose2& robot_
     v.cmd_vx = c->value.vx_mps;
     v.cmd_vy = c->value.vy_mps;
   }
+  if (const auto c = daemon.control_status().read(); c && c->value.tracking) {
+    v.tracking = true;
+    v.plan_tracking = c->value.best_cost.tracking;
+    v.plan_collision = c->value.best_cost.collision;
+    v.plan_barrier = c->value.best_cost.barrier;
+  }
   return v;
 }
 

@@ -121,6 +121,48 @@ TEST(Mppi, GoesAroundAWallBetweenRobotAndGoal) {
   EXPECT_LT(std::hypot(loop.robot.x_m - goal.x_m, loop.robot.y_m - goal.y_m), 0.2);
 }
 
+// The best rollout's cost by term (published in the status and the evaluation's samples, to say
+// why the robot left q^d): each term where its cause is, and the terms sum to the total.
+TEST(Mppi, TheBestPlansCostIsSplitIntoItsTermsWhereTheirCausesAre) {
+  auto sums_to_total = [](const core::MppiOutput& out) {
+    const auto& b = out.best;
+    return std::abs(b.tracking + b.collision + b.barrier + b.control - out.min_cost) <=
+           1e-4 * std::max(1.0, std::abs(out.min_cost));
+  };
+  {  // Open floor, a goal 2 m ahead: tracking only.
+    Loop loop(test_config());
+    const auto out = loop.tick(Pose2{2, 0, 0}, {}, nullptr);
+    ASSERT_TRUE(out.ok);
+    EXPECT_GT(out.best.tracking, 0.0);
+    EXPECT_EQ(out.best.collision, 0.0);
+    EXPECT_EQ(out.best.barrier, 0.0);
+    EXPECT_TRUE(sums_to_total(out)) << out.min_cost;
+  }
+  {  // The robot standing in the wall's lethal zone (at rest it cannot leave it within a step):
+     // every plan crosses lethal cells, whole steps of collision_cost.
+    const core::Costmap map = wall_map();
+    auto cfg = test_config();
+    Loop loop(cfg);
+    loop.robot = Pose2{1.5, 0, 0};
+    const auto out = loop.tick(Pose2{0.5, 0, 0}, {}, &map);
+    ASSERT_TRUE(out.ok);
+    EXPECT_GE(out.best.collision, cfg.collision_cost);
+    EXPECT_NEAR(std::fmod(out.best.collision, cfg.collision_cost), 0.0, 1e-3);
+    EXPECT_EQ(out.best.barrier, 0.0);
+    EXPECT_TRUE(sums_to_total(out)) << out.min_cost;
+  }
+  {  // The robot at the centre of a standing person's ellipse: no plan leaves it as fast as the
+     // DCBF asks (h from -1 to >= -0.5 in one 0.1 s step), so the best plan pays the barrier.
+    Loop loop(test_config());
+    const std::vector<Pose2> person(31, Pose2{0, 0, 0});
+    const auto out = loop.tick(Pose2{0, -1.0, 0}, person, nullptr);
+    ASSERT_TRUE(out.ok);
+    EXPECT_GT(out.best.barrier, 0.0);
+    EXPECT_EQ(out.best.collision, 0.0);
+    EXPECT_TRUE(sums_to_total(out)) << out.min_cost;
+  }
+}
+
 TEST(Mppi, RespectsVelocityAndAccelerationLimits) {
   auto cfg = test_config();
   cfg.limits = {0.8, 0.5, 1.0};

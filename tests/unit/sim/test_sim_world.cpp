@@ -486,15 +486,25 @@ TEST(RunMetrics, SectorsNameTheSidesOfThePerson) {
   EXPECT_STREQ(sim::sector_name(sim::sector_of(-std::numbers::pi / 2)), "right");
 }
 
-TEST(RunMetrics, SamplesCarryTheDaemonsCommandToDiagnoseATrial) {
+TEST(RunMetrics, SamplesCarryTheDaemonsCommandAndPlanCostsToDiagnoseATrial) {
   sim::RunMetricsRecorder r;
   sim::DaemonView v;
   v.active = true;
   v.cmd_vx = 0.75;
   v.cmd_vy = -0.25;
+  v.tracking = true;
+  v.plan_tracking = 12.5;
+  v.plan_collision = 3000.0;
+  v.plan_barrier = 0.0;
   r.record(0.0, 0.01, Pose2{-1, 0, 0}, Pose2{0, 0, 0}, {}, 5.0, 1.0, v);
-  ASSERT_EQ(r.samples().size(), 1U);
+  v.tracking = false;  // holding: no plan
+  r.record(0.2, 0.01, Pose2{-1, 0, 0}, Pose2{0, 0, 0}, {}, 5.0, 1.0, v);
+  ASSERT_EQ(r.samples().size(), 2U);
   const std::string csv = sim::samples_csv(r.samples());
-  EXPECT_NE(csv.find(",cmd_vx_mps,cmd_vy_mps\n"), std::string::npos) << csv;
-  EXPECT_NE(csv.find(",0.750,-0.250\n"), std::string::npos) << csv;
+  EXPECT_NE(
+      csv.find(",cmd_vx_mps,cmd_vy_mps,plan_tracking_cost,plan_collision_cost,plan_barrier_cost\n"),
+      std::string::npos)
+      << csv;
+  EXPECT_NE(csv.find(",0.750,-0.250,12.5,3000.0,0.0\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",0.750,-0.250,nan,nan,nan\n"), std::string::npos) << csv;
 }

@@ -60,6 +60,16 @@ struct MppiInputs {
   std::span<const Pose2> goal_path;
 };
 
+// The best rollout's cost by term (they sum to its total): what the controller is trading off.
+// A collision term of n x collision_cost means its best plan crosses n steps of lethal costmap;
+// a barrier term, that it enters the person's ellipse faster than the DCBF allows.
+struct MppiCostTerms {
+  double tracking = 0;   // stage + terminal tracking of q^d
+  double collision = 0;  // collision_cost per step at costmap cost >= R
+  double barrier = 0;    // c_safe max((1 - delta) h_k - h_{k+1}, 0)
+  double control = 0;    // lambda u^T Sigma^-1 eps (may be negative)
+};
+
 struct MppiOutput {
   Twist command;    // repaired and limited
   Twist nominal;    // the first control of the optimised mean, before repair
@@ -67,6 +77,7 @@ struct MppiOutput {
   bool repaired = false;
   bool repair_feasible = true;
   double min_cost = 0;           // best sample's cost
+  MppiCostTerms best;            // ... by term
   double effective_samples = 0;  // 1 / sum(w^2): how many samples carried the update
   double lambda = 0;             // the temperature used (>= config lambda)
 };
@@ -93,7 +104,8 @@ class Mppi {
   std::vector<float> pool_;       // standard normals
   std::vector<uint32_t> offset_;  // per block of kLanes samples: where its noise starts
   std::vector<double> cost_;      // per sample
-  std::vector<double> weight_;    // per sample
+  std::vector<float> tracking_cost_, collision_cost_, barrier_cost_;  // per sample, by term
+  std::vector<double> weight_;                                        // per sample
   std::vector<uint32_t> active_;  // samples that carry weight (capacity M: no allocation)
   uint64_t rng_state_;
   // Prepared once per step for the rollouts.

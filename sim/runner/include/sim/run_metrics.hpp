@@ -28,6 +28,8 @@ struct RunSample {  // for pictures: every 100 ms
   bool active = false;
   int side = -1;                          // sector of the chosen point (0..7), -1 none
   double cmd_vx_mps = 0, cmd_vy_mps = 0;  // the daemon's last command, base_link
+  // The controller's best rollout by cost term (NaN when it is not tracking): why it left q^d.
+  double plan_tracking = 0, plan_collision = 0, plan_barrier = 0;
 };
 
 // What failed a run first: the tables count these.
@@ -74,6 +76,8 @@ struct DaemonView {
   core::Pose2 goal_world;
   int side = -1;
   double cmd_vx = 0, cmd_vy = 0;
+  bool tracking = false;  // the controller ran on q^d: plan_* hold its best rollout's terms
+  double plan_tracking = 0, plan_collision = 0, plan_barrier = 0;
 };
 
 class RunMetricsRecorder {
