@@ -5,8 +5,9 @@
 
 namespace hal {
 
-// `received_now` is the monotonic time of the read; the result is earlier by the datagram's age
-// in the socket queue. Ages outside [0, 1 s) (the wall clock jumped) are ignored.
+// `received_now` is the monotonic time the read stands for (the caller's `now`); the result is
+// earlier by the datagram's age at that time, and never later than it. Ages outside [0, 1 s)
+// (the wall clock jumped) are ignored.
 Nanos monotonic_from_kernel_stamp(Nanos kernel_realtime, Nanos received_now);
 
 }  // namespace hal

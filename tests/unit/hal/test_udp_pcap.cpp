@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "hal/capture/pcap_file.hpp"
+#include "hal/kernel_stamp.hpp"
 #include "hal/linux_clock.hpp"
 #include "hal/net/udp_socket.hpp"
 
@@ -59,6 +60,46 @@ TEST(UdpReceiver, ReceivesWithKernelStampsAndSource) {
   EXPECT_EQ(rx.stats().datagrams, 3U);
   EXPECT_EQ(rx.stats().bytes, 3U * 1206U);
   EXPECT_EQ(rx.drain(10, now, [](const hal::UdpDatagram&) {}), 0U) << "non-blocking when empty";
+}
+
+namespace {
+// The monotonic clock minus the realtime clock, from readings less than 50 us apart (retried
+// until they are: a preemption between them would skew it).
+hal::Nanos monotonic_minus_realtime() {
+  auto read = [](clockid_t id) {
+    timespec ts{};
+    clock_gettime(id, &ts);
+    return hal::Nanos(static_cast<int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec);
+  };
+  for (;;) {
+    const hal::Nanos m0 = read(CLOCK_MONOTONIC);
+    const hal::Nanos r = read(CLOCK_REALTIME);
+    const hal::Nanos m1 = read(CLOCK_MONOTONIC);
+    if (m1 - m0 < 50us) return m0 + (m1 - m0) / 2 - r;
+  }
+}
+}  // namespace
+
+TEST(KernelStamp, IsTheArrivalTimeEvenWhenTheCallersNowIsOld) {
+  // The caller took `now` 20 ms ago (then drained a long queue, or was preempted: CI saw 3 ms on
+  // a loaded machine). A datagram that arrived 30 ms ago is stamped 30 ms ago, not 50; one that
+  // arrived 5 ms ago, after `now`, is stamped `now`.
+  hal::LinuxClock clock;
+  const hal::Nanos offset = monotonic_minus_realtime();
+  const hal::Nanos mono = clock.now();
+  const hal::Nanos caller_now = mono - 20ms;
+  const hal::Nanos arrived_30ms_ago = mono - 30ms;
+  const hal::Nanos stamp = hal::monotonic_from_kernel_stamp(arrived_30ms_ago - offset, caller_now);
+  EXPECT_NEAR(static_cast<double>((stamp - arrived_30ms_ago).count()), 0.0, 1e6) << "within 1 ms";
+  EXPECT_EQ(hal::monotonic_from_kernel_stamp(mono - 5ms - offset, caller_now), caller_now);
+  // On a simulated clock (`now` not monotonic time) the age is taken as it is; a wall-clock jump
+  // (an age of minutes, or negative) leaves `now`.
+  const hal::Nanos sim_now = 5s;
+  const hal::Nanos aged = hal::monotonic_from_kernel_stamp(mono - 30ms - offset, sim_now);
+  EXPECT_LE(aged, sim_now - 30ms);
+  EXPECT_GT(aged, sim_now - 100ms);
+  EXPECT_EQ(hal::monotonic_from_kernel_stamp(mono - 120s - offset, sim_now), sim_now);
+  EXPECT_EQ(hal::monotonic_from_kernel_stamp(mono + 10s - offset, sim_now), sim_now);
 }
 
 TEST(UdpReceiver, OnASimulatedClockDatagramsTakeTheDrainsTime) {
