@@ -169,6 +169,13 @@ int run(int argc, char** argv) {
   app.add_flag("--person-walks-through", person_walks_through,
                "the followed person keeps to their script even into the robot (default: they "
                "do not walk into it; contacts the robot causes count either way)");
+  std::vector<double> costmap_at;
+  app.add_option("--costmap-at", costmap_at,
+                 "write the daemon's costmap at these times (s) of each trial as map_server maps "
+                 "(OUT/costmaps/CASE-METHOD-SEED-tT.pgm/.yaml, with robot, person, q^d and the "
+                 "controller's plan costs; draw with sim/eval/plot_costmap.py)")
+      ->delimiter(',')
+      ->check(CLI::NonNegativeNumber);
   CLI11_PARSE(app, argc, argv);
 
   const auto loaded = config_path.empty() ? firmware::load_default_config()
@@ -247,6 +254,12 @@ int run(int argc, char** argv) {
       o.seed = t.seed;
       o.duration_s = duration_s;
       o.person_avoids_robot = !person_walks_through;
+      if (!costmap_at.empty()) {
+        std::filesystem::create_directories(out_dir + "/costmaps");
+        o.costmap_at_s = costmap_at;
+        o.costmap_stem =
+            fmt::format("{}/costmaps/{}-{}-{}", out_dir, t.c->name, t.method->name, t.seed);
+      }
       const sim::SimRunResult r = sim::run_simulation(o);
       Outcome& out = outcomes[i];
       out.trial = t;

@@ -26,7 +26,7 @@ TEST(CompanionEval, RunsCasesAndMethodsByNameAndWritesTablesCsvAndPlots) {
   const std::string out = ::testing::TempDir() + "companion-eval-ci";
   ChildProcess p({COMPANION_EVAL_PATH, "--case", "corridor,crowd-5", "--trials", "2", "--method",
                   "objective,fixed_side,pid", "--duration-s", "8", "--jobs", "2", "--samples",
-                  "--out", out});
+                  "--costmap-at", "6", "--out", out});
   ASSERT_TRUE(p.started());
   ASSERT_EQ(p.wait(600s), 0) << p.output();
   const std::string csv = slurp(out + "/trials.csv");
@@ -49,6 +49,14 @@ TEST(CompanionEval, RunsCasesAndMethodsByNameAndWritesTablesCsvAndPlots) {
     ASSERT_GT(png.size(), 1000U) << f;
     EXPECT_EQ(png.substr(1, 3), "PNG") << f;
   }
+  // A costmap snapshot per trial (map_server PGM + YAML), drawn by plot_costmap.py.
+  const std::string snap = out + "/costmaps/corridor-objective-1-t6.0";
+  EXPECT_NE(slurp(snap + ".yaml").find("image: corridor-objective-1-t6.0.pgm"), std::string::npos);
+  EXPECT_EQ(slurp(snap + ".pgm").substr(0, 2), "P5");
+  ChildProcess draw({"/usr/bin/python3", COMPANION_PLOT_COSTMAP_SCRIPT, snap + ".yaml"});
+  ASSERT_TRUE(draw.started());
+  ASSERT_EQ(draw.wait(120s), 0) << draw.output();
+  EXPECT_EQ(slurp(snap + ".png").substr(1, 3), "PNG");
 }
 
 TEST(CompanionEval, TheOneCommandBenchmarkWritesEveryTableAndPlot) {

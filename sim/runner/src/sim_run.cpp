@@ -1,14 +1,19 @@
 #include "sim/sim_run.hpp"
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
+#include <filesystem>
+#include <fstream>
 #include <thread>
 
 #include "firmware/daemon.hpp"
 #include "firmware/task_table.hpp"
 #include "hal/sd_notify.hpp"
 #include "hal/sim_clock.hpp"
+#include "sim/costmap_snapshot.hpp"
 
 namespace sim {
 
@@ -62,6 +67,48 @@ DaemonView daemon_view(const firmware::Daemon& daemon, const core::Pose2& robot_
   return v;
 }
 
+namespace {
+// Writes the daemon's latest costmap and what it knew at t_s (SimRunOptions::costmap_at_s).
+void write_costmap_snapshot(const firmware::Daemon& daemon, const firmware::DaemonConfig& cfg,
+                            core::Nanos now, const std::string& stem) {
+  const double t_s = core::to_seconds(now);
+  const auto map = daemon.costmap().latest();
+  if (map->cells() == 0) return;  // none built yet
+  CostmapMarks m;
+  m.t_s = t_s;
+  m.cost_threshold = cfg.interactive_space.cost_threshold;
+  if (const auto b = daemon.base_health().read()) m.robot_odom = b->value.odom;
+  if (const auto g = daemon.goal().read(); g && g->value.status == core::GoalStatus::kOk) {
+    m.has_goal = true;
+    m.goal_odom = g->value.goal_odom;
+    m.has_person = true;
+    m.person_odom = g->value.person_odom;
+  }
+  const auto track = daemon.human_track().read();
+  if (m.has_goal && track && track->value.valid) {
+    // Where the controller expects the person and q^d over its horizon (as run_controller).
+    std::vector<core::Pose2> person(static_cast<size_t>(cfg.mppi.horizon_steps) + 1);
+    core::predict_path(track->value, now, cfg.mppi.step_s, person);
+    const core::Pose2 goal_in_person = m.person_odom.inverse() * m.goal_odom;
+    const auto every = static_cast<size_t>(std::max(1L, std::lround(1.0 / cfg.mppi.step_s)));
+    for (size_t k = 0; k < person.size(); k += every) {
+      m.predicted_person.push_back(person[k]);
+      m.predicted_goal.push_back(person[k] * goal_in_person);
+    }
+  }
+  if (const auto c = daemon.control_status().read(); c && c->value.tracking) {
+    m.tracking = true;
+    m.plan_tracking = c->value.best_cost.tracking;
+    m.plan_collision = c->value.best_cost.collision;
+    m.plan_barrier = c->value.best_cost.barrier;
+  }
+  const std::string base = fmt::format("{}-t{:.1f}", stem, t_s);
+  const std::string image = std::filesystem::path(base + ".pgm").filename().string();
+  std::ofstream(base + ".pgm", std::ios::binary) << costmap_pgm(*map);
+  std::ofstream(base + ".yaml") << costmap_yaml(*map, image, m);
+}
+}  // namespace
+
 SimRunResult run_simulation(const SimRunOptions& o) {
   using Clock = std::chrono::steady_clock;
   const auto wall_start = Clock::now();
@@ -113,11 +160,18 @@ SimRunResult run_simulation(const SimRunOptions& o) {
     };
   }
   const double step_s = world.config().step_s;
+  std::vector<double> costmap_at = o.costmap_at_s;
+  std::sort(costmap_at.begin(), costmap_at.end());
+  size_t next_costmap = 0;
   const auto step_ns = static_cast<uint32_t>(std::lround(1.0 / step_s));
   tasks.push_back({core::TaskSpec{"world", step_ns, 1000, firmware::kGroupRealtime, 255},
                    [&](const core::Tick& tick) {
                      const double t_s = core::to_seconds(tick.now);
                      if (o.script) o.script(t_s, world, daemon);
+                     while (next_costmap < costmap_at.size() && t_s >= costmap_at[next_costmap]) {
+                       write_costmap_snapshot(daemon, cfg, tick.now, o.costmap_stem);
+                       ++next_costmap;
+                     }
                      world.step(tick.now);
                      const core::Pose2 robot = world.robot_pose();
                      recorder.record(

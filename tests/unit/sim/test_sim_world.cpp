@@ -1,19 +1,27 @@
 // The simulated world's parts: geometry, walks, recorded datasets, social force, the VLP-16
 // emulation (decoded by the real decoder), the tracker emulation (read by the real person frame),
 // the in-process datagram link, and the run metrics.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <numbers>
+#include <sstream>
 
 #include "amfitrack/amfiprot_codec.hpp"
 #include "amfitrack/person_frame.hpp"
+#include "core/perception/voxel_grid.hpp"
+#include "firmware/config/config_loader.hpp"
 #include "hal/net/datagram_queue.hpp"
 #include "hal/sim_clock.hpp"
+#include "sim/costmap_snapshot.hpp"
 #include "sim/pedestrian_dataset.hpp"
 #include "sim/run_metrics.hpp"
 #include "sim/run_report.hpp"
+#include "sim/sim_run.hpp"
 #include "sim/sim_vlp16.hpp"
 #include "sim/sim_world.hpp"
 #include "sim/social_force.hpp"
@@ -507,4 +515,103 @@ TEST(RunMetrics, SamplesCarryTheDaemonsCommandAndPlanCostsToDiagnoseATrial) {
       << csv;
   EXPECT_NE(csv.find(",0.750,-0.250,12.5,3000.0,0.0\n"), std::string::npos) << csv;
   EXPECT_NE(csv.find(",0.750,-0.250,nan,nan,nan\n"), std::string::npos) << csv;
+}
+
+// ---- costmap snapshots (companion-eval --costmap-at) ------------------------------------------
+
+namespace {
+core::Costmap wall_costmap() {  // a wall across x = 1.5 m, |y| <= 0.6 m, in a 10 m map
+  core::VoxelGridConfig gc;
+  gc.size_xy_m = 10.0;
+  core::VoxelGrid g(gc);
+  g.recentre(1.5, 0);
+  std::vector<core::Ray> rays;
+  for (double y = -0.6; y <= 0.6; y += 0.02)
+    rays.push_back({{1.5, -3.0, 3.0}, {1.5, y, 0.5}});
+  g.insert(rays, Pose2{30, 30, 0}, std::nullopt, 1s);
+  core::Costmap m;
+  m.build(g, core::CostmapConfig{}, 1s);
+  return m;
+}
+}  // namespace
+
+TEST(CostmapSnapshot, IsAMapServerPgmWithTheTopRowTheLargestY) {
+  const core::Costmap map = wall_costmap();
+  const int n = map.cells();
+  const std::string pgm = sim::costmap_pgm(map);
+  const std::string header = "P5\n" + std::to_string(n) + " " + std::to_string(n) + "\n255\n";
+  ASSERT_EQ(pgm.compare(0, header.size(), header), 0);
+  ASSERT_EQ(pgm.size(), header.size() + static_cast<size_t>(n) * static_cast<size_t>(n));
+  auto pixel = [&](double x, double y) {
+    const int i = static_cast<int>(std::floor((x - map.origin_x()) / map.resolution()));
+    const int j = static_cast<int>(std::floor((y - map.origin_y()) / map.resolution()));
+    const size_t row = static_cast<size_t>(n - 1 - j);  // the top row is the largest y
+    return static_cast<uint8_t>(
+        pgm[header.size() + row * static_cast<size_t>(n) + static_cast<size_t>(i)]);
+  };
+  ASSERT_EQ(map.at(1.5, 0.0), core::kCostLethal);
+  EXPECT_EQ(pixel(1.5, 0.0), 0) << "lethal is black";
+  EXPECT_EQ(pixel(1.5, 3.0), 255) << "free is white";
+  EXPECT_EQ(pixel(-2.0, 0.0), 255);
+  // Inflation: grey between, darker nearer the wall.
+  EXPECT_LT(pixel(1.5, 0.95), pixel(1.5, 1.2));
+}
+
+TEST(CostmapSnapshot, YamlHasTheMapServerKeysAndWhatTheDaemonKnew) {
+  const core::Costmap map = wall_costmap();
+  sim::CostmapMarks m;
+  m.t_s = 9.5;
+  m.robot_odom = Pose2{0.5, 1.5, 0.25};
+  m.has_goal = m.has_person = true;
+  m.person_odom = Pose2{1, 0, 0};
+  m.goal_odom = Pose2{1, 0.7, 0};
+  m.tracking = true;
+  m.plan_tracking = 5199.9;
+  m.predicted_person = {Pose2{1, 0, 0}, Pose2{1.8, 0, 0}};
+  m.predicted_goal = {Pose2{1, 0.7, 0}, Pose2{1.8, 0.7, 0}};
+  const std::string y = sim::costmap_yaml(map, "snap.pgm", m);
+  const std::vector<std::string> wanted = {
+      "image: snap.pgm\n",
+      "resolution: 0.05\n",
+      fmt::format("origin: [{:.4f}, {:.4f}, 0.0]\n", map.origin_x(), map.origin_y()),
+      "negate: 0\n",
+      "occupied_thresh: 0.300\n",
+      "t_s: 9.500\n",
+      "robot: [0.5000, 1.5000, 0.2500]\n",
+      "goal: [1.0000, 0.7000, 0.0000]\n",
+      "predicted_goal: [[1.0000, 0.7000, 0.0000], [1.8000, 0.7000, 0.0000]]\n",
+      "plan_cost: {tracking: 5199.9, collision: 0.0, barrier: 0.0}\n"};
+  for (const std::string& want : wanted) {
+    EXPECT_NE(y.find(want), std::string::npos) << want << " in\n" << y;
+  }
+  m.tracking = m.has_goal = m.has_person = false;
+  const std::string holding = sim::costmap_yaml(map, "snap.pgm", m);
+  EXPECT_NE(holding.find("goal: null\n"), std::string::npos) << holding;
+  EXPECT_NE(holding.find("plan_cost: null\n"), std::string::npos) << holding;
+}
+
+TEST(CostmapSnapshot, ARunWritesOneAtEachTimeAsked) {
+  const auto dir = std::filesystem::path(testing::TempDir()) / "companion-costmap-snapshots";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  sim::SimRunOptions o;
+  o.config = *firmware::load_default_config().config;
+  o.scenario = *sim::make_scenario("static_obstacle");
+  o.duration_s = 2.5;
+  o.costmap_at_s = {2.0, 1.5};
+  o.costmap_stem = (dir / "trial").string();
+  sim::run_simulation(o);
+  for (const char* t : {"1.5", "2.0"}) {
+    const auto stem = dir / (std::string("trial-t") + t);
+    std::ifstream yaml(stem.string() + ".yaml");
+    ASSERT_TRUE(yaml.good()) << stem;
+    std::stringstream text;
+    text << yaml.rdbuf();
+    EXPECT_NE(text.str().find("image: trial-t" + std::string(t) + ".pgm"), std::string::npos);
+    std::ifstream pgm(stem.string() + ".pgm", std::ios::binary);
+    ASSERT_TRUE(pgm.good()) << stem;
+    std::string head(2, '\0');
+    pgm.read(head.data(), 2);
+    EXPECT_EQ(head, "P5");
+  }
 }

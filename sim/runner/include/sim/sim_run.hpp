@@ -35,6 +35,10 @@ struct SimRunOptions {
   bool capture_can = false;         // keep every CAN frame the daemon sends
   bool quiet = true;                // daemon logs at warning level and above only
   bool person_avoids_robot = true;  // SimWorldConfig::person_avoids_robot
+  // The daemon's costmap at these times (s), written as map_server maps STEM-t<time>.pgm/.yaml
+  // with what the daemon knew then (sim/costmap_snapshot.hpp): to see why a trial went wrong.
+  std::vector<double> costmap_at_s;
+  std::string costmap_stem;
 };
 
 struct SimRunResult {
