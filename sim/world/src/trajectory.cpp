@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
+#include <optional>
 
 namespace sim {
 
@@ -62,49 +64,158 @@ double path_length(const Trajectory& t) {
   return len;
 }
 
-Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s, double step_s) {
+namespace {
+
+double distance(core::Point2 a, core::Point2 b) {
+  return std::hypot(b.x_m - a.x_m, b.y_m - a.y_m);
+}
+
+// One piece of a walk: standing, a straight line or a circular arc, from t0_s to t1_s.
+struct WalkPiece {
+  double t0_s = 0;
+  double t1_s = 0;
+  core::Point2 from;
+  core::Point2 to;  // lines (and standing: from == to)
+  bool arc = false;
+  core::Point2 centre;
+  double radius_m = 0;
+  double start_angle_rad = 0;
+  double turn_rad = 0;  // signed: positive turns left
+
+  [[nodiscard]] core::Point2 at(double t_s) const {
+    const double span = t1_s - t0_s;
+    const double u = span > 0 ? std::clamp((t_s - t0_s) / span, 0.0, 1.0) : 1.0;
+    if (arc) {
+      const double a = start_angle_rad + u * turn_rad;
+      return {centre.x_m + radius_m * std::cos(a), centre.y_m + radius_m * std::sin(a)};
+    }
+    return {from.x_m + u * (to.x_m - from.x_m), from.y_m + u * (to.y_m - from.y_m)};
+  }
+  // The walking direction; none while standing.
+  [[nodiscard]] std::optional<double> heading_at(double t_s) const {
+    if (arc) {
+      const double span = t1_s - t0_s;
+      const double u = span > 0 ? std::clamp((t_s - t0_s) / span, 0.0, 1.0) : 1.0;
+      const double quarter = turn_rad > 0 ? std::numbers::pi / 2 : -std::numbers::pi / 2;
+      return core::wrap_angle(start_angle_rad + u * turn_rad + quarter);
+    }
+    if (distance(from, to) < 1e-9) return std::nullopt;
+    return std::atan2(to.y_m - from.y_m, to.x_m - from.x_m);
+  }
+};
+
+class WalkBuilder {
+ public:
+  explicit WalkBuilder(core::Point2 start) : here_(start) {}
+  void stand(double duration_s) {
+    if (duration_s > 0) add_line(here_, duration_s);
+  }
+  void line_to(core::Point2 to, double speed_mps) {
+    add_line(to, distance(here_, to) / std::max(speed_mps, 0.05));
+  }
+  // The arc from here (on the incoming leg, heading `in_dir`) turning by `turn_rad`.
+  void arc(core::Point2 in_dir, double turn_rad, double radius_m, double speed_mps) {
+    const double side = turn_rad > 0 ? 1.0 : -1.0;
+    WalkPiece p;
+    p.arc = true;
+    p.t0_s = t_s_;
+    p.from = here_;
+    p.centre = {here_.x_m - side * in_dir.y_m * radius_m, here_.y_m + side * in_dir.x_m * radius_m};
+    p.radius_m = radius_m;
+    p.start_angle_rad = std::atan2(here_.y_m - p.centre.y_m, here_.x_m - p.centre.x_m);
+    p.turn_rad = turn_rad;
+    p.t1_s = t_s_ + radius_m * std::abs(turn_rad) / std::max(speed_mps, 0.05);
+    t_s_ = p.t1_s;
+    here_ = p.at(t_s_);
+    p.to = here_;
+    pieces_.push_back(p);
+  }
+  [[nodiscard]] core::Point2 here() const { return here_; }
+  [[nodiscard]] double end_s() const { return t_s_; }
+  [[nodiscard]] const std::vector<WalkPiece>& pieces() const { return pieces_; }
+
+ private:
+  void add_line(core::Point2 to, double duration_s) {
+    WalkPiece p;
+    p.t0_s = t_s_;
+    p.t1_s = t_s_ + duration_s;
+    p.from = here_;
+    p.to = to;
+    pieces_.push_back(p);
+    t_s_ += duration_s;
+    here_ = to;
+  }
+  core::Point2 here_;
+  double t_s_ = 0;
+  std::vector<WalkPiece> pieces_;
+};
+
+}  // namespace
+
+Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s, double step_s,
+                const CornerLimits& corner) {
   std::vector<TimedPose> out;
   if (waypoints.empty()) return Trajectory(out);
-  // Event list: (time, position) at every corner, then sampled.
-  struct Knot {
-    double t;
-    core::Point2 p;
-  };
-  std::vector<Knot> knots{{0.0, waypoints.front().p}};
-  double t = start_s;
-  if (start_s > 0) knots.push_back({start_s, waypoints.front().p});
-  if (waypoints.front().pause_s > 0) {
-    t += waypoints.front().pause_s;
-    knots.push_back({t, waypoints.front().p});
-  }
+  const bool round_corners = corner.lateral_accel_mps2 > 0 && corner.turn_rate_radps > 0;
+  WalkBuilder b(waypoints.front().p);
+  b.stand(start_s);
+  b.stand(waypoints.front().pause_s);
   for (size_t i = 1; i < waypoints.size(); ++i) {
-    const auto& a = waypoints[i - 1].p;
-    const auto& b = waypoints[i];
-    const double len = std::hypot(b.p.x_m - a.x_m, b.p.y_m - a.y_m);
-    t += len / std::max(b.speed_mps, 0.05);
-    knots.push_back({t, b.p});
-    if (b.pause_s > 0) {
-      t += b.pause_s;
-      knots.push_back({t, b.p});
+    const Waypoint& w = waypoints[i];
+    const core::Point2 a = waypoints[i - 1].p;
+    const double len_in = distance(a, w.p);
+    const bool last = i + 1 == waypoints.size();
+    const double len_out = last ? 0.0 : distance(w.p, waypoints[i + 1].p);
+    if (!round_corners || last || w.pause_s > 0 || len_in < 1e-6 || len_out < 1e-6) {
+      b.line_to(w.p, w.speed_mps);
+      b.stand(w.pause_s);
+      continue;
     }
+    const core::Point2 in{(w.p.x_m - a.x_m) / len_in, (w.p.y_m - a.y_m) / len_in};
+    const core::Point2 next = waypoints[i + 1].p;
+    const core::Point2 out_dir{(next.x_m - w.p.x_m) / len_out, (next.y_m - w.p.y_m) / len_out};
+    const double turn = std::atan2(in.x_m * out_dir.y_m - in.y_m * out_dir.x_m,
+                                   in.x_m * out_dir.x_m + in.y_m * out_dir.y_m);
+    if (std::abs(turn) < 1e-3) {
+      b.line_to(w.p, w.speed_mps);
+      continue;
+    }
+    // The tightest arc at walking speed v: r = max(v^2 / a_lat, v / omega). Its tangent points
+    // lie r tan(turn / 2) before and after the corner; where the legs are too short for that
+    // (each corner may use at most 45 % of a leg), the arc is tighter and walked slower.
+    double v = std::min(w.speed_mps, waypoints[i + 1].speed_mps);
+    double r = std::max(v * v / corner.lateral_accel_mps2, v / corner.turn_rate_radps);
+    const double half_tan = std::tan(std::abs(turn) / 2);
+    const double max_cut_m = 0.45 * std::min(len_in, len_out);
+    if (r * half_tan > max_cut_m) {
+      r = max_cut_m / half_tan;
+      v = std::min({v, std::sqrt(corner.lateral_accel_mps2 * r), corner.turn_rate_radps * r});
+    }
+    const double cut = r * half_tan;
+    b.line_to({w.p.x_m - cut * in.x_m, w.p.y_m - cut * in.y_m}, w.speed_mps);
+    b.arc(in, turn, r, v);
   }
+  const double t = b.end_s();
+  const auto& pieces = b.pieces();
+  // Headings from the pieces (the tangent on arcs), kept while standing; before the first
+  // step the walker already faces it.
+  std::optional<double> first_heading;
+  for (const WalkPiece& p : pieces) {
+    first_heading = p.heading_at(p.t0_s);
+    if (first_heading) break;
+  }
+  double heading = first_heading.value_or(0.0);
   size_t k = 0;
   const auto steps = static_cast<size_t>(std::floor(t / step_s + 1e-9));
   for (size_t i = 0; i <= steps; ++i) {
     const double s = static_cast<double>(i) * step_s;
-    while (k + 1 < knots.size() && knots[k + 1].t < s)
+    while (k + 1 < pieces.size() && pieces[k].t1_s <= s)
       ++k;
-    core::Point2 p = knots[k].p;
-    if (k + 1 < knots.size()) {
-      const double span = knots[k + 1].t - knots[k].t;
-      const double u = span > 0 ? (s - knots[k].t) / span : 1.0;
-      p = {knots[k].p.x_m + u * (knots[k + 1].p.x_m - knots[k].p.x_m),
-           knots[k].p.y_m + u * (knots[k + 1].p.y_m - knots[k].p.y_m)};
-    }
-    out.push_back({s, {p.x_m, p.y_m, 0.0}});
+    const core::Point2 p = pieces.empty() ? b.here() : pieces[k].at(s);
+    if (!pieces.empty()) heading = pieces[k].heading_at(s).value_or(heading);
+    out.push_back({s, {p.x_m, p.y_m, heading}});
   }
-  out.push_back({t, {knots.back().p.x_m, knots.back().p.y_m, 0.0}});
-  set_headings_from_motion(out);
+  out.push_back({t, {b.here().x_m, b.here().y_m, heading}});
   return Trajectory(std::move(out));
 }
 

@@ -61,7 +61,8 @@ TEST(StaticWorld, BoxesAreClosedPolygons) {
 // ---- walks -----------------------------------------------------------------------------------
 
 TEST(Walk, LegsAtTheirSpeedsWithSuddenTurns) {
-  const auto t = sim::walk({{{0, 0}}, {{4, 0}, 1.0}, {{4, 2}, 0.5}}, 1.0);
+  const sim::CornerLimits sudden{0.0, 0.0};
+  const auto t = sim::walk({{{0, 0}}, {{4, 0}, 1.0}, {{4, 2}, 0.5}}, 1.0, 0.05, sudden);
   EXPECT_NEAR(t.end_s(), 1.0 + 4.0 + 4.0, 1e-9);
   auto p = t.pose_at(0.5);
   EXPECT_NEAR(p.x_m, 0.0, 1e-9) << "standing before the start";
@@ -75,6 +76,70 @@ TEST(Walk, LegsAtTheirSpeedsWithSuddenTurns) {
   EXPECT_NEAR(p.theta_rad, std::numbers::pi / 2, 1e-6) << "turned at the corner";
   EXPECT_NEAR(t.velocity_at(7.0).y_m, 0.5, 1e-6);
   EXPECT_NEAR(t.pose_at(100).y_m, 2.0, 1e-9) << "stays at the end";
+}
+
+// Heading rate (rad/s) and lateral acceleration (m/s^2) at their largest along a walk, from its
+// samples (as the simulator moves the person).
+struct TurnPeaks {
+  double turn_rate_radps = 0;
+  double lateral_accel_mps2 = 0;
+};
+TurnPeaks turn_peaks(const sim::Trajectory& t) {
+  TurnPeaks peaks;
+  const auto& s = t.samples();
+  for (size_t i = 1; i + 1 < s.size(); ++i) {
+    const double dt = s[i + 1].t_s - s[i].t_s;
+    if (dt < 1e-6) continue;
+    const double rate =
+        std::abs(core::wrap_angle(s[i + 1].pose.theta_rad - s[i].pose.theta_rad)) / dt;
+    const double speed =
+        std::hypot(s[i + 1].pose.x_m - s[i].pose.x_m, s[i + 1].pose.y_m - s[i].pose.y_m) / dt;
+    peaks.turn_rate_radps = std::max(peaks.turn_rate_radps, rate);
+    peaks.lateral_accel_mps2 = std::max(peaks.lateral_accel_mps2, rate * speed);
+  }
+  return peaks;
+}
+
+TEST(Walk, TurnsACornerOnAnArcAWalkingPersonCanWalk) {
+  // 1.4 m/s into a 90-degree left corner: r = v^2 / 3 m/s^2 = 0.65 m, not on the spot.
+  const sim::CornerLimits limits;  // 3 m/s^2, 3 rad/s
+  const auto t = sim::walk({{{0, 0}}, {{8, 0}, 1.4}, {{8, 8}, 1.4}}, 0.0, 0.05, limits);
+  const double r = 1.4 * 1.4 / limits.lateral_accel_mps2;
+  const auto peaks = turn_peaks(t);
+  EXPECT_LE(peaks.turn_rate_radps, limits.turn_rate_radps * 1.05);
+  EXPECT_LE(peaks.lateral_accel_mps2, limits.lateral_accel_mps2 * 1.05);
+  EXPECT_GT(peaks.turn_rate_radps, 1.4 / r * 0.9) << "and as tight as the limits allow";
+  // The corner is cut by r(sqrt 2 - 1) at its closest, and the time is the arc's, not more.
+  double closest = 1e9;
+  for (const auto& s : t.samples())
+    closest = std::min(closest, std::hypot(s.pose.x_m - 8.0, s.pose.y_m));
+  EXPECT_NEAR(closest, r * (std::sqrt(2.0) - 1.0), 0.02);
+  const double arc_time = r * std::numbers::pi / 2 / 1.4;
+  EXPECT_NEAR(t.end_s(), (16.0 - 2 * r) / 1.4 + arc_time, 1e-6);
+  EXPECT_NEAR(t.pose_at(t.end_s()).theta_rad, std::numbers::pi / 2, 1e-3) << "facing the new leg";
+  // Mid-corner the heading is halfway round, not already turned.
+  const double mid = (8.0 - r) / 1.4 + arc_time / 2;
+  EXPECT_NEAR(t.pose_at(mid).theta_rad, std::numbers::pi / 4, 0.1);
+}
+
+TEST(Walk, ATurnBackOnShortLegsIsWalkedSlowerNotFaster) {
+  // 170 degrees between 1 m legs: the arc that fits is tiny, so the turn rate limit sets the
+  // time (a person turns round, they do not spin at 1.4 m/s).
+  const sim::CornerLimits limits;
+  const double back = 170.0 * std::numbers::pi / 180.0;
+  const auto t = sim::walk({{{0, 0}}, {{1, 0}, 1.4}, {{1 + std::cos(back), std::sin(back)}, 1.4}},
+                           0.0, 0.01, limits);
+  const auto peaks = turn_peaks(t);
+  EXPECT_LE(peaks.turn_rate_radps, limits.turn_rate_radps * 1.05);
+  EXPECT_LE(peaks.lateral_accel_mps2, limits.lateral_accel_mps2 * 1.05);
+  EXPECT_GE(t.end_s(), back / limits.turn_rate_radps) << "at least the time to turn round";
+}
+
+TEST(Walk, APauseAtACornerTurnsOnTheSpot) {
+  const auto t = sim::walk({{{0, 0}}, {{4, 0}, 1.0, 1.0}, {{4, 2}, 1.0}}, 0.0);
+  EXPECT_NEAR(t.pose_at(4.5).x_m, 4.0, 1e-9) << "stands at the corner itself";
+  EXPECT_NEAR(t.pose_at(4.5).y_m, 0.0, 1e-9);
+  EXPECT_NEAR(t.end_s(), 7.0, 1e-9);
 }
 
 TEST(Walk, HeadingIsKeptWhileStanding) {

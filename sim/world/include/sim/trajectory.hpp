@@ -30,15 +30,23 @@ class Trajectory {
   std::vector<TimedPose> samples_;
 };
 
-// A waypoint walk: legs at their own speeds, optional pauses, sudden turns at the corners (the
-// walker faces the next leg at once, as people do at a corner).
+// A waypoint walk: legs at their own speeds, optional pauses, and corners taken the way a
+// walking person can: on an arc no tighter than their lateral acceleration and turn rate allow
+// (a 90-degree corner at 1.4 m/s takes ~0.7 s, about one stride), slowing down only where the
+// legs are too short for that arc. A person who pauses at a waypoint turns there on the spot.
+// `corner` with zero limits gives the old sudden turns (the walker faces the next leg at once).
 struct Waypoint {
   core::Point2 p;
   double speed_mps = 1.0;  // on the leg that ends here
   double pause_s = 0;      // standing here before the next leg
 };
+struct CornerLimits {
+  double lateral_accel_mps2 = 3.0;  // v^2 / r while turning
+  double turn_rate_radps = 3.0;     // v / r: ~170 deg/s, a quick turn in one step
+};
 // Sampled every `step_s`, starting at `start_s` (standing at the first waypoint until then).
-Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s = 0.0, double step_s = 0.05);
+Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s = 0.0, double step_s = 0.05,
+                const CornerLimits& corner = {});
 
 // Headings of position samples from their motion (kept while standing: below 0.2 m/s).
 // Path length walked (m).
