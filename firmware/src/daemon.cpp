@@ -85,6 +85,7 @@ core::HumanEkfConfig human_ekf_config(const DaemonConfig& cfg) {
   c.yaw_rate_noise_radps = h.yaw_rate_noise_radps;
   c.accel_noise_mps2 = h.accel_noise_mps2;
   c.yaw_accel_noise_radps2 = h.yaw_accel_noise_radps2;
+  c.prediction_time_constant_s = h.prediction_time_constant_s;
   c.gate_probability = h.gate_probability;
   c.reset_after_rejects = static_cast<uint32_t>(h.reset_after_rejects);
   c.reset_after_gap = core::from_ms(h.reset_after_gap_ms);
@@ -543,11 +544,17 @@ bool Daemon::run_controller(Nanos now, core::BodyVelocity& requested) {
   const double lag_s = std::clamp(core::to_seconds(now - b.odom_stamp), 0.0, kMaxOdomLagS);
   const core::Pose2 robot =
       b.odom * core::Pose2{b.vx_mps * lag_s, b.vy_mps * lag_s, b.wz_radps * lag_s};
-  core::predict_path(track->value, now, mppi_.config().step_s, person_path_);
+  // The person for the barrier: constant velocity, the conservative prediction of where they
+  // may be. q^d, the point to be at, walks with them on a prediction whose velocity fades
+  // (human.prediction_time_constant_s): at constant velocity it runs ~15 m ahead over the 10 s
+  // horizon, off the costmap, where every rollout that follows it dies.
+  core::predict_path(track->value, now, mppi_.config().step_s, 0.0, person_path_);
+  core::predict_path(track->value, now, mppi_.config().step_s,
+                     human_config_.prediction_time_constant_s, goal_path_);
   // q^d is a point of the person's interactive space: it walks with them over the horizon.
   const core::Pose2 goal_in_person = goal->value.person_odom.inverse() * goal->value.goal_odom;
-  for (size_t k = 0; k < person_path_.size(); ++k)
-    goal_path_[k] = person_path_[k] * goal_in_person;
+  for (core::Pose2& g : goal_path_)
+    g = g * goal_in_person;
   const auto map = costmap_.latest();
 
   core::MppiInputs in;

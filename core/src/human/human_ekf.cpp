@@ -94,12 +94,17 @@ HumanTrack predict_track(const HumanTrack& track, Nanos t, const HumanEkfConfig&
   return out;
 }
 
-void predict_path(const HumanTrack& track, Nanos t0, double dt_s, std::span<Pose2> out) {
+void predict_path(const HumanTrack& track, Nanos t0, double dt_s, double time_constant_s,
+                  std::span<Pose2> out) {
   const double t0_s = to_seconds(t0 - track.stamp);
   for (size_t k = 0; k < out.size(); ++k) {
     const double t = t0_s + dt_s * static_cast<double>(k);
-    out[k] = Pose2{track.mean()(0) + track.mean()(3) * t, track.mean()(1) + track.mean()(4) * t,
-                   wrap_angle(track.mean()(2) + track.mean()(5) * t)};
+    // Seconds of walking at the current velocity that the prediction amounts to (the
+    // integral of exp(-t / tau)); before the stamp the track's own constant-velocity model.
+    const double s =
+        time_constant_s > 0.0 && t > 0.0 ? time_constant_s * -std::expm1(-t / time_constant_s) : t;
+    out[k] = Pose2{track.mean()(0) + track.mean()(3) * s, track.mean()(1) + track.mean()(4) * s,
+                   wrap_angle(track.mean()(2) + track.mean()(5) * s)};
   }
 }
 

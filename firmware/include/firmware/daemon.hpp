@@ -271,7 +271,7 @@ class Daemon {
   core::PidFollower pid_;
   bool use_pid_ = false;                  // control.controller: pid_follower (evaluation baseline)
   std::vector<core::Pose2> person_path_;  // the person's predicted poses at the MPPI steps
-  std::vector<core::Pose2> goal_path_;    // q^d carried along person_path_
+  std::vector<core::Pose2> goal_path_;    // q^d carried along the person's faded prediction
   core::Twist last_command_;              // the gate's previous output (MPPI's start control)
   ControlStatus control_state_;
   core::LatestValue<ControlStatus> control_status_;

@@ -411,6 +411,16 @@ std::vector<FieldSpec> build() {
        0.01,
        50.0,
        {}},
+      {"human.prediction_time_constant_s",
+       "s",
+       "How long the person's current velocity lasts in the prediction that carries q^d over the "
+       "controller's horizon: q^d moves v tau (1 - exp(-t / tau)), at most v tau (0: constant "
+       "velocity, ~15 m in 10 s, off the costmap). The barrier keeps constant velocity. "
+       "2 s tracks closer but, measured, touches a turning person more (docs/EVALUATION.md).",
+       FIELD(human.prediction_time_constant_s),
+       0.0,
+       60.0,
+       {}},
       {"human.gate_probability",
        "-",
        "Chi-square gate of the filter: a pose outside this probability mass is an outlier (0.99, "

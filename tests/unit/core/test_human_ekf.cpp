@@ -219,7 +219,7 @@ TEST(HumanEkf, PredictsToQueryTimesAndIntoTheRobotFrame) {
   track.stamp = 1s;
   track.last_update = 1s;
   std::array<Pose2, 3> path;
-  core::predict_path(track, 1500ms, 0.1, path);
+  core::predict_path(track, 1500ms, 0.1, 0.0, path);  // constant velocity
   EXPECT_NEAR(path[0].x_m, 1.5, 1e-12);
   EXPECT_NEAR(path[2].x_m, 1.7, 1e-12);
   EXPECT_NEAR(path[2].y_m, 2.35, 1e-12);
@@ -253,6 +253,35 @@ TEST(HumanEkf, PredictsToQueryTimesAndIntoTheRobotFrame) {
   EXPECT_EQ(
       core::human_state(track, 2s, base_in_odom, cfg, core::TrackerConfidence::kGood).confidence,
       core::TrackerConfidence::kGood);
+}
+
+// Over the controller's 10 s horizon the prediction fades the person's velocity: constant
+// velocity at first, then at most v tau in all (so q^d's path stays on the 12 m costmap).
+TEST(HumanEkf, PredictionFadesTheVelocityWithItsTimeConstant) {
+  core::HumanTrack track;
+  track.valid = true;
+  track.mean() << 0.0, 0.0, 0.0, 1.5, 0.0, 0.3;  // walking 1.5 m/s along x, turning 0.3 rad/s
+  track.stamp = 1s;
+  std::array<Pose2, 101> faded{};
+  std::array<Pose2, 101> constant{};
+  const double tau_s = 2.0;
+  core::predict_path(track, 1s, 0.1, tau_s, faded);
+  core::predict_path(track, 1s, 0.1, 0.0, constant);
+  EXPECT_NEAR(constant[100].x_m, 15.0, 1e-9) << "constant velocity: 10 s at 1.5 m/s";
+  // The first step is nearly constant velocity (1.5 * 2 * (1 - e^-0.05) = 0.1463 m).
+  EXPECT_NEAR(faded[1].x_m, 0.1463, 1e-4);
+  // At 2 s: v tau (1 - 1/e); at 10 s nearly v tau = 3 m, never beyond.
+  EXPECT_NEAR(faded[20].x_m, 1.5 * tau_s * (1.0 - std::exp(-1.0)), 1e-9);
+  EXPECT_NEAR(faded[100].x_m, 3.0, 0.03);
+  EXPECT_LT(faded[100].x_m, 3.0);
+  EXPECT_NEAR(faded[100].theta_rad, 0.3 * faded[100].x_m / 1.5, 1e-9) << "the turn fades alike";
+  for (size_t k = 1; k < faded.size(); ++k) {
+    EXPECT_GT(faded[k].x_m, faded[k - 1].x_m) << "still moving forward at step " << k;
+  }
+  // Before the stamp (a late query of an older track) it is the constant-velocity model.
+  std::array<Pose2, 1> before{};
+  core::predict_path(track, 500ms, 0.1, tau_s, before);
+  EXPECT_NEAR(before[0].x_m, -0.75, 1e-12);
 }
 
 }  // namespace

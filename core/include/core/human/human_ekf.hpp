@@ -30,6 +30,11 @@ struct HumanEkfConfig {
   Nanos reset_after_gap = std::chrono::milliseconds(1000);  // no accepted pose this long
   double initial_speed_sigma_mps = 1.5;
   double initial_yaw_rate_sigma_radps = 1.5;
+  // Prediction of where q^d will be over the controller's horizon (predict_path): the person's
+  // velocity is known now and less and less later. A first-order Markov (Singer) velocity with
+  // this time constant predicts the displacement v tau (1 - exp(-t / tau)): constant velocity at
+  // first, at most v tau in all. 0: constant velocity over the whole horizon.
+  double prediction_time_constant_s = 0.0;
 };
 
 using HumanVector = Eigen::Matrix<double, 6, 1>;
@@ -94,8 +99,11 @@ class HumanEkf {
 // The track moved forward (or backward) to `t` with the model; covariance grows with |dt|.
 HumanTrack predict_track(const HumanTrack& track, Nanos t, const HumanEkfConfig& config);
 
-// Constant-velocity prediction of the person's pose at t0, t0 + dt, ... (out.size() poses).
-void predict_path(const HumanTrack& track, Nanos t0, double dt_s, std::span<Pose2> out);
+// The person's predicted pose at t0, t0 + dt, ... (out.size() poses): the track's velocity and
+// turn rate, fading with `time_constant_s` after the track's stamp (0: constant velocity; see
+// HumanEkfConfig::prediction_time_constant_s).
+void predict_path(const HumanTrack& track, Nanos t0, double dt_s, double time_constant_s,
+                  std::span<Pose2> out);
 // The person's position at t (before or after the track's stamp), constant velocity.
 Point2 position_at(const HumanTrack& track, Nanos t);
 
