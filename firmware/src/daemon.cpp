@@ -134,6 +134,14 @@ core::MppiConfig mppi_config(const DaemonConfig& cfg) {
   c.ellipse = core::Ellipse{cfg.interactive_space.ellipse_a_m, cfg.interactive_space.ellipse_b_m};
   c.limits =
       core::TwistLimits{cfg.limits.vx_max_mps, cfg.limits.vy_max_mps, cfg.limits.wz_max_radps};
+  c.closing.robot_decel_mps2 = cfg.closing_speed.robot_decel_mps2;
+  c.closing.person_decel_mps2 = cfg.closing_speed.person_decel_mps2;
+  c.closing.reaction_time_s = cfg.closing_speed.reaction_time_s;
+  c.closing.margin_m = cfg.closing_speed.margin_m;
+  c.closing.person_radius_m = cfg.closing_speed.person_radius_m;
+  c.closing.footprint =
+      core::Footprint{cfg.costmap.footprint_x_min_m, cfg.costmap.footprint_x_max_m,
+                      cfg.costmap.footprint_y_min_m, cfg.costmap.footprint_y_max_m};
   c.linear_accel_mps2 = cfg.limits.linear_accel_max_mps2;
   c.angular_accel_radps2 = cfg.limits.angular_accel_max_radps2;
   c.threads = static_cast<int>(m.threads);
@@ -545,12 +553,16 @@ bool Daemon::run_controller(Nanos now, core::BodyVelocity& requested) {
   const core::Pose2 robot =
       b.odom * core::Pose2{b.vx_mps * lag_s, b.vy_mps * lag_s, b.wz_radps * lag_s};
   // The person for the barrier: constant velocity, the conservative prediction of where they
-  // may be. q^d, the point to be at, walks with them on a prediction whose velocity fades
-  // (human.prediction_time_constant_s): at constant velocity it runs ~15 m ahead over the 10 s
-  // horizon, off the costmap, where every rollout that follows it dies.
+  // may be. q^d, the point to be at, walks with them; with human.prediction_time_constant_s on
+  // a fading velocity that keeps it on the costmap (at constant velocity, the default, it runs
+  // ~15 m ahead over the 10 s horizon, off the map; why that is still the default: EVALUATION.md).
   core::predict_path(track->value, now, mppi_.config().step_s, 0.0, person_path_);
-  core::predict_path(track->value, now, mppi_.config().step_s,
-                     human_config_.prediction_time_constant_s, goal_path_);
+  if (human_config_.prediction_time_constant_s > 0.0) {
+    core::predict_path(track->value, now, mppi_.config().step_s,
+                       human_config_.prediction_time_constant_s, goal_path_);
+  } else {
+    std::copy(person_path_.begin(), person_path_.end(), goal_path_.begin());
+  }
   // q^d is a point of the person's interactive space: it walks with them over the horizon.
   const core::Pose2 goal_in_person = goal->value.person_odom.inverse() * goal->value.goal_odom;
   for (core::Pose2& g : goal_path_)
@@ -581,6 +593,8 @@ bool Daemon::run_controller(Nanos now, core::BodyVelocity& requested) {
   }
   control_state_.repaired = out.repaired;
   if (out.repaired) ++control_state_.repairs;
+  control_state_.closing_limited = out.closing_limited;
+  if (out.closing_limited) ++control_state_.closing_limits;
   control_state_.min_cost = out.min_cost;
   control_state_.best_cost = out.best;
   control_state_.effective_samples = out.effective_samples;

@@ -94,6 +94,7 @@ std::string Daemon::build_status_json(core::Nanos now) const {
                     {"runs", v.runs},
                     {"failures", v.failures},
                     {"repairs", v.repairs},
+                    {"closing_limits", v.closing_limits},
                     {"effective_samples", number(v.effective_samples)},
                     {"min_cost", number(v.min_cost)},
                     {"best_cost",

@@ -363,6 +363,18 @@ MppiOutput Mppi::step(const MppiInputs& in) {
     u = r.u;
     out.repaired = r.modified;
     out.repair_feasible = r.feasible;
+    if (cfg_.closing.robot_decel_mps2 > 0.0) {
+      // The person's position and velocity in base_link (the velocity of the prediction's
+      // first step: the filter's).
+      const Pose2 odom_in_base = in.robot.inverse();
+      const Point2 person = odom_in_base.apply({p0.x_m, p0.y_m});
+      const Point2 velocity =
+          odom_in_base.rotate({(p1.x_m - p0.x_m) / cfg_.step_s, (p1.y_m - p0.y_m) / cfg_.step_s});
+      const ClosingSpeedResult c =
+          limit_closing_speed(person, velocity, u, cfg_.closing, cfg_.limits);
+      u = c.u;
+      out.closing_limited = c.limited;
+    }
   }
   // Acceleration limits against the last command, over the time since the last step.
   const double dv = cfg_.linear_accel_mps2 * elapsed;

@@ -819,6 +819,48 @@ std::vector<FieldSpec> build() {
        0.0,
        1e9,
        {}},
+      {"closing_speed.robot_decel_mps2",
+       "m/s^2",
+       "Speed and separation toward the person: the robot never moves toward them faster than "
+       "it can stop from at this deceleration, after closing_speed.reaction_time_s, before its "
+       "footprint is closing_speed.margin_m from their body (plus the way they would take to "
+       "stop at closing_speed.person_decel_mps2 if walking away). Only slows the command, never "
+       "reverses it. Below the base's limits.linear_accel_max_mps2 for latency and slip. "
+       "0: off (the paper's controller).",
+       FIELD(closing_speed.robot_decel_mps2),
+       0.0,
+       10.0,
+       {}},
+      {"closing_speed.person_decel_mps2",
+       "m/s^2",
+       "How hard the person is assumed to be able to stop: the credit the robot takes for a "
+       "person walking away from it (large: none).",
+       FIELD(closing_speed.person_decel_mps2),
+       0.1,
+       100.0,
+       {}},
+      {"closing_speed.reaction_time_s",
+       "s",
+       "Time before braking begins: the control period plus the base's command latency.",
+       FIELD(closing_speed.reaction_time_s),
+       0.0,
+       1.0,
+       {}},
+      {"closing_speed.margin_m",
+       "m",
+       "Gap left between the robot's footprint (costmap.footprint_*) and the person's body after "
+       "a stop.",
+       FIELD(closing_speed.margin_m),
+       0.0,
+       2.0,
+       {}},
+      {"closing_speed.person_radius_m",
+       "m",
+       "The person's body as a circle around the tracked position.",
+       FIELD(closing_speed.person_radius_m),
+       0.0,
+       1.0,
+       {}},
   };
 }
 

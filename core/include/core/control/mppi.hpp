@@ -17,6 +17,7 @@
 #include <span>
 #include <vector>
 
+#include "core/control/closing_speed.hpp"
 #include "core/control/dcbf_repair.hpp"
 #include "core/geometry/pose2.hpp"
 #include "core/perception/costmap.hpp"
@@ -41,6 +42,9 @@ struct MppiConfig {
   double c_safe = 5000.0;
   Ellipse ellipse;
   TwistLimits limits;
+  // Speed and separation toward the person, applied to the repaired command (closing_speed.hpp;
+  // robot_decel_mps2 = 0: off).
+  ClosingSpeedConfig closing;
   double linear_accel_mps2 = 1.5;  // applied to the output command
   double angular_accel_radps2 = 3.0;
   bool smooth = true;  // 3-tap smoothing of the updated mean sequence
@@ -76,6 +80,7 @@ struct MppiOutput {
   bool ok = false;  // false: numerical failure, command is zero
   bool repaired = false;
   bool repair_feasible = true;
+  bool closing_limited = false;  // slowed toward the person (ClosingSpeedConfig)
   double min_cost = 0;           // best sample's cost
   MppiCostTerms best;            // ... by term
   double effective_samples = 0;  // 1 / sum(w^2): how many samples carried the update

@@ -149,6 +149,14 @@ struct DaemonConfig {
     double delta = 0;
     double c_safe = 0;
   } dcbf;
+
+  struct ClosingSpeed {
+    double robot_decel_mps2 = 0;  // 0: off
+    double person_decel_mps2 = 0;
+    double reaction_time_s = 0;
+    double margin_m = 0;
+    double person_radius_m = 0;
+  } closing_speed;
 };
 
 }  // namespace firmware

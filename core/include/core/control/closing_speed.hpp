@@ -1,0 +1,54 @@
+#pragma once
+// Speed and separation monitoring toward the followed person (after ISO/TS 15066's SSM): the
+// robot never moves toward the person faster than it can stop from before its footprint
+// reaches them, if they stopped too.
+//   gap D: the distance from the robot's footprint (a box in base_link) to the person's body
+//          (a circle), less `margin_m`;
+//   n: the unit direction from the footprint's nearest point to the person's centre;
+//   v_r: that point's velocity toward the person, n . (v + w x r), linear in the command;
+//   v_p: the person's velocity away from the robot, n . v_person, counted only when >= 0;
+//   the robot stops in v_r t_r + v_r^2 / (2 a_r) (reaction time, then braking at a_r);
+//   the person, if they stop, in v_p^2 / (2 a_p);
+//   limit: v_r t_r + v_r^2 / (2 a_r) <= D + v_p^2 / (2 a_p).
+// The limit is never negative, so a command is only ever slowed, never turned into motion
+// away: standing still always satisfies it (the person who walks toward a standing robot is
+// theirs to avoid, as with any obstacle; the DCBF keeps the robot out of their ellipse).
+// The command is the least change (Euclidean in vx, vy, wz) that meets the limit, clipped to the
+// velocity box, then scaled toward zero if the box pushed it back over. Why it exists: with q^d
+// on the ellipse's edge, a robot catching up at 1.5 m/s met the person's turn faster than its
+// 1.5 m/s^2 brakes could stop in the 0.2-0.4 m left between the bodies (docs/EVALUATION.md).
+#include "core/control/dcbf_repair.hpp"
+#include "core/geometry/pose2.hpp"
+
+namespace core {
+
+struct Footprint {
+  double x_min_m = -0.35, x_max_m = 0.35, y_min_m = -0.30, y_max_m = 0.30;  // base_link box
+};
+
+struct ClosingSpeedConfig {
+  double robot_decel_mps2 = 0;     // a_r; 0 = off
+  double person_decel_mps2 = 3.0;  // a_p: how hard the person is assumed to be able to stop
+  double reaction_time_s = 0.05;   // t_r: command latency and the control period
+  double margin_m = 0.10;          // gap left between the bodies after a stop
+  double person_radius_m = 0.25;
+  Footprint footprint;
+};
+
+struct ClosingSpeedResult {
+  Twist u;
+  bool limited = false;        // the command was slowed
+  double gap_m = 0;            // footprint to the person's body (negative: overlapping)
+  double closing_mps = 0;      // the command's speed of the nearest point toward the person
+  double max_closing_mps = 0;  // what the limit allows
+};
+
+// The largest speed toward the person that still stops in time (>= 0).
+double max_closing_speed(double gap_m, double person_receding_mps, const ClosingSpeedConfig& c);
+
+// `person_in_base` and `person_velocity_in_base` (the person's own velocity, base_link axes).
+ClosingSpeedResult limit_closing_speed(const Point2& person_in_base,
+                                       const Point2& person_velocity_in_base, const Twist& u,
+                                       const ClosingSpeedConfig& c, const TwistLimits& limits);
+
+}  // namespace core

@@ -1,0 +1,145 @@
+// Speed and separation toward the person (core/control/closing_speed.hpp).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/control/closing_speed.hpp"
+
+using core::ClosingSpeedConfig;
+using core::Point2;
+using core::Twist;
+
+namespace {
+
+ClosingSpeedConfig on(double decel = 1.0) {
+  ClosingSpeedConfig c;
+  c.robot_decel_mps2 = decel;
+  return c;
+}
+
+const core::TwistLimits kLimits{1.8, 1.5, 2.0};
+
+// The person's centre `gap` ahead of the footprint's front face (plus their radius).
+Point2 ahead(double gap_m, const ClosingSpeedConfig& c) {
+  return {c.footprint.x_max_m + c.person_radius_m + gap_m, 0.0};
+}
+
+}  // namespace
+
+TEST(ClosingSpeed, OffLeavesTheCommandAlone) {
+  const ClosingSpeedConfig c;  // robot_decel_mps2 = 0
+  const auto r =
+      core::limit_closing_speed(ahead(0.05, c), {0, 0}, Twist{1.5, 0.2, 0.3}, c, kLimits);
+  EXPECT_FALSE(r.limited);
+  EXPECT_DOUBLE_EQ(r.u.vx, 1.5);
+  EXPECT_DOUBLE_EQ(r.u.vy, 0.2);
+  EXPECT_DOUBLE_EQ(r.u.wz, 0.3);
+}
+
+TEST(ClosingSpeed, TheLimitStopsInTheGapLeft) {
+  const ClosingSpeedConfig c = on(1.0);
+  for (const double gap : {0.15, 0.3, 0.6, 1.2}) {
+    const double v = core::max_closing_speed(gap, 0.0, c);
+    // reaction, then braking: exactly the room between the bodies less the margin
+    EXPECT_NEAR(v * c.reaction_time_s + v * v / (2.0 * c.robot_decel_mps2), gap - c.margin_m, 1e-9)
+        << gap;
+  }
+  EXPECT_DOUBLE_EQ(core::max_closing_speed(c.margin_m, 0.0, c), 0.0);
+  EXPECT_DOUBLE_EQ(core::max_closing_speed(-0.2, 0.0, c), 0.0) << "overlapping: never closer";
+}
+
+TEST(ClosingSpeed, SlowsOnlyThePartTowardThePerson) {
+  const ClosingSpeedConfig c = on(1.0);
+  const auto r = core::limit_closing_speed(ahead(0.3, c), {0, 0}, Twist{1.5, 0.4, 0}, c, kLimits);
+  ASSERT_TRUE(r.limited);
+  EXPECT_NEAR(r.gap_m, 0.3, 1e-12);
+  EXPECT_NEAR(r.u.vx, core::max_closing_speed(0.3, 0.0, c), 1e-12);
+  EXPECT_DOUBLE_EQ(r.u.vy, 0.4) << "the sideways part does not close on them";
+  EXPECT_DOUBLE_EQ(r.u.wz, 0.0);
+}
+
+TEST(ClosingSpeed, APersonWalkingAwayIsCreditedTheWayTheyWouldTakeToStop) {
+  const ClosingSpeedConfig c = on(1.0);
+  const double standing = core::max_closing_speed(0.3, 0.0, c);
+  const auto r = core::limit_closing_speed(ahead(0.3, c), {1.4, 0.0}, Twist{1.5, 0, 0}, c, kLimits);
+  EXPECT_GT(r.max_closing_mps, standing + 0.3);
+  // robot: v t + v^2 / 2 a_r; person: 1.4^2 / 2 a_p
+  const double v = r.max_closing_mps;
+  EXPECT_NEAR(v * c.reaction_time_s + v * v / 2.0, 0.3 - c.margin_m + 1.4 * 1.4 / (2 * 3.0), 1e-9);
+  // walking toward the robot gives no credit and takes none: the limit is the standing one
+  const auto toward =
+      core::limit_closing_speed(ahead(0.3, c), {-1.4, 0.0}, Twist{1.5, 0, 0}, c, kLimits);
+  EXPECT_NEAR(toward.max_closing_mps, standing, 1e-12);
+}
+
+TEST(ClosingSpeed, NeverTurnsACommandIntoMotionAway) {
+  const ClosingSpeedConfig c = on(1.0);
+  // touching, the person coming closer: the robot may stand, it is not pushed back
+  const auto r = core::limit_closing_speed(ahead(0.0, c), {-1.0, 0}, Twist{0.8, 0, 0}, c, kLimits);
+  ASSERT_TRUE(r.limited);
+  EXPECT_NEAR(r.u.vx, 0.0, 1e-12);
+  const auto still = core::limit_closing_speed(ahead(0.0, c), {-1.0, 0}, Twist{}, c, kLimits);
+  EXPECT_FALSE(still.limited);
+  // moving away is never limited
+  const auto away = core::limit_closing_speed(ahead(0.0, c), {0, 0}, Twist{-0.5, 0, 0}, c, kLimits);
+  EXPECT_FALSE(away.limited);
+  EXPECT_DOUBLE_EQ(away.u.vx, -0.5);
+}
+
+TEST(ClosingSpeed, ACornerSwungTowardThePersonCounts) {
+  const ClosingSpeedConfig c = on(1.0);
+  // The person just left of the front-left corner (0.35, 0.30), the footprint's nearest point:
+  // turning left moves that corner at w z x r = (-0.30 w, 0.35 w), toward them at 0.35 w.
+  const Point2 person{0.35, 0.30 + c.person_radius_m + 0.12};
+  const auto r = core::limit_closing_speed(person, {0, 0}, Twist{0, 0, 2.0}, c, kLimits);
+  ASSERT_TRUE(r.limited);
+  EXPECT_NEAR(r.closing_mps, 0.35 * 2.0, 1e-9);
+  const double after = r.u.vy + 0.35 * r.u.wz;  // n = (0, 1)
+  EXPECT_NEAR(after, r.max_closing_mps, 1e-9);
+}
+
+TEST(ClosingSpeed, TheVelocityBoxDoesNotUndoTheLimit) {
+  const ClosingSpeedConfig c = on(1.0);
+  // The person ahead-right of the front-right corner (0.35, -0.30), at 45 degrees: the least
+  // change lowers vx and raises vy, here past its box at 1.5 m/s; the clipped command is then
+  // scaled until it meets the limit.
+  const double d = 0.11 + c.person_radius_m;
+  const double n = 1.0 / std::sqrt(2.0);
+  const Point2 person{0.35 + d * n, -0.30 - d * n};
+  const auto r = core::limit_closing_speed(person, {0, 0}, Twist{1.8, 1.5, 0}, c, kLimits);
+  ASSERT_TRUE(r.limited);
+  EXPECT_LE(std::abs(r.u.vx), kLimits.vx);
+  EXPECT_LE(std::abs(r.u.vy), kLimits.vy);
+  // n = (1, -1) / sqrt 2; the corner moves at w z x r = (0.30 w, 0.35 w)
+  const double closing = n * (r.u.vx + 0.30 * r.u.wz) - n * (r.u.vy + 0.35 * r.u.wz);
+  EXPECT_NEAR(closing, r.max_closing_mps, 1e-9);
+  EXPECT_LT(r.u.vy, 1.5) << "scaled after the box clipped vy";
+}
+
+// A robot driving at 1.5 m/s at a person standing 2 m ahead, braking at most 1.0 m/s^2 after
+// a command latency of 20 ms: with the limit it stops short of them, without it it does not.
+TEST(ClosingSpeed, ADrivingRobotStopsShortOfAStandingPerson) {
+  auto run = [](double decel) {
+    ClosingSpeedConfig c = on(decel);
+    const double person_x = c.footprint.x_max_m + c.person_radius_m + 2.0;
+    double x = 0.0, v = 1.5;
+    double min_gap = 1e9;
+    const double dt = 0.01;
+    double queued = v, queued2 = v;  // 20 ms latency
+    for (int i = 0; i < 400; ++i) {
+      Twist want{1.5, 0, 0};
+      if (decel > 0)
+        want = core::limit_closing_speed({person_x - x, 0}, {0, 0}, want, c, kLimits).u;
+      // what the base does: the command two periods ago, at most 1.0 m/s^2 of change
+      const double target = queued2;
+      queued2 = queued;
+      queued = want.vx;
+      v = std::clamp(target, v - 1.0 * dt, v + 1.0 * dt);
+      x += v * dt;
+      min_gap = std::min(min_gap, person_x - x - c.footprint.x_max_m - c.person_radius_m);
+    }
+    return min_gap;
+  };
+  EXPECT_GT(run(1.0), 0.0);
+  EXPECT_LT(run(0.0), 0.0) << "without the limit the robot reaches them";
+}
