@@ -135,7 +135,7 @@ core::MppiConfig mppi_config(const DaemonConfig& cfg) {
   c.limits =
       core::TwistLimits{cfg.limits.vx_max_mps, cfg.limits.vy_max_mps, cfg.limits.wz_max_radps};
   c.closing.robot_decel_mps2 = cfg.closing_speed.robot_decel_mps2;
-  c.closing.person_decel_mps2 = cfg.closing_speed.person_decel_mps2;
+  c.closing.person_accel_mps2 = cfg.closing_speed.person_accel_mps2;
   c.closing.reaction_time_s = cfg.closing_speed.reaction_time_s;
   c.closing.margin_m = cfg.closing_speed.margin_m;
   c.closing.person_radius_m = cfg.closing_speed.person_radius_m;

@@ -5,15 +5,43 @@
 
 namespace core {
 
-double max_closing_speed(double gap_m, double person_receding_mps, const ClosingSpeedConfig& c) {
+double person_approach_m(double time_s, double receding_mps, double speed_mps, double accel_mps2) {
+  // Their speed toward the robot starts at -receding and grows at accel up to a cap: what they
+  // do not already spend walking away (one walking straight away may stop, not come back; one
+  // walking across or toward the robot may turn into it at their speed).
+  const double start = -receding_mps;
+  const double cap =
+      std::max(std::clamp(speed_mps - std::max(receding_mps, 0.0), 0.0, speed_mps), start);
+  if (accel_mps2 <= 0.0) return start * time_s;
+  const double ramp_s = (cap - start) / accel_mps2;  // >= 0
+  if (time_s <= ramp_s) return start * time_s + 0.5 * accel_mps2 * time_s * time_s;
+  return start * ramp_s + 0.5 * accel_mps2 * ramp_s * ramp_s + cap * (time_s - ramp_s);
+}
+
+double max_closing_speed(double gap_m, double receding_mps, double speed_mps,
+                         const ClosingSpeedConfig& c) {
   const double a = c.robot_decel_mps2;
   const double t = c.reaction_time_s;
-  double room_m = std::max(gap_m - c.margin_m, 0.0);
-  if (person_receding_mps > 0.0) {
-    room_m += person_receding_mps * person_receding_mps / (2.0 * c.person_decel_mps2);
+  const double room_m = std::max(gap_m - c.margin_m, 0.0);
+  // The robot at v stops after T = t + v / a, having moved v t + v^2 / (2 a) toward the person;
+  // meanwhile they come person_approach_m(T) closer. Both are convex in v (the person's speed
+  // toward the robot only grows), so the speeds that keep the sum within the room are [0, v_max].
+  auto closed_m = [&](double v) {
+    return v * t + v * v / (2.0 * a) +
+           person_approach_m(t + v / a, receding_mps, speed_mps, c.person_accel_mps2);
+  };
+  if (a <= 0.0 || closed_m(0.0) > room_m) return 0.0;
+  double lo = 0.0;
+  double hi = 4.0;
+  for (int i = 0; i < 16 && closed_m(hi) <= room_m; ++i) {
+    lo = hi;
+    hi *= 2.0;
   }
-  // v t + v^2 / (2 a) = room  ->  v = -a t + sqrt((a t)^2 + 2 a room)
-  return std::max(-a * t + std::sqrt(a * t * a * t + 2.0 * a * room_m), 0.0);
+  for (int i = 0; i < 40; ++i) {  // 4 m/s / 2^40: far below anything the base resolves
+    const double mid = 0.5 * (lo + hi);
+    (closed_m(mid) <= room_m ? lo : hi) = mid;
+  }
+  return lo;
 }
 
 ClosingSpeedResult limit_closing_speed(const Point2& person_in_base,
@@ -48,7 +76,8 @@ ClosingSpeedResult limit_closing_speed(const Point2& person_in_base,
   const double g2 = -nx * near.y_m + ny * near.x_m;
   auto closing = [&](const Twist& t) { return g0 * t.vx + g1 * t.vy + g2 * t.wz; };
   const double receding = nx * person_velocity_in_base.x_m + ny * person_velocity_in_base.y_m;
-  out.max_closing_mps = max_closing_speed(out.gap_m, receding, c);
+  const double speed = std::hypot(person_velocity_in_base.x_m, person_velocity_in_base.y_m);
+  out.max_closing_mps = max_closing_speed(out.gap_m, receding, speed, c);
   out.closing_mps = closing(u);
   if (c.robot_decel_mps2 <= 0.0 || out.closing_mps <= out.max_closing_mps) return out;
 

@@ -415,8 +415,10 @@ std::vector<FieldSpec> build() {
        "s",
        "How long the person's current velocity lasts in the prediction that carries q^d over the "
        "controller's horizon: q^d moves v tau (1 - exp(-t / tau)), at most v tau (0: constant "
-       "velocity, ~15 m in 10 s, off the costmap). The barrier keeps constant velocity. "
-       "2 s tracks closer but, measured, touches a turning person more (docs/EVALUATION.md).",
+       "velocity, ~15 m in 10 s, off the costmap, where the robot lagged and lost the person). "
+       "The barrier keeps constant velocity. Tracking this closely is safe with "
+       "closing_speed.robot_decel_mps2 on; without it, measured, it touched a turning person "
+       "more (docs/EVALUATION.md).",
        FIELD(human.prediction_time_constant_s),
        0.0,
        60.0,
@@ -823,21 +825,21 @@ std::vector<FieldSpec> build() {
        "m/s^2",
        "Speed and separation toward the person: the robot never moves toward them faster than "
        "it can stop from at this deceleration, after closing_speed.reaction_time_s, before its "
-       "footprint is closing_speed.margin_m from their body (plus the way they would take to "
-       "stop at closing_speed.person_decel_mps2 if walking away). Only slows the command, never "
-       "reverses it. Below the base's limits.linear_accel_max_mps2 for latency and slip. "
-       "0: off (the paper's controller).",
+       "footprint comes within closing_speed.margin_m of their body, counting their velocity "
+       "toward or away from it and that it may turn toward it at closing_speed.person_accel_mps2. "
+       "Only slows the command, never reverses it. Below the base's limits.linear_accel_max_mps2 "
+       "for latency and slip. 0: off (the paper's controller).",
        FIELD(closing_speed.robot_decel_mps2),
        0.0,
        10.0,
        {}},
-      {"closing_speed.person_decel_mps2",
+      {"closing_speed.person_accel_mps2",
        "m/s^2",
-       "How hard the person is assumed to be able to stop: the credit the robot takes for a "
-       "person walking away from it (large: none).",
-       FIELD(closing_speed.person_decel_mps2),
-       0.1,
-       100.0,
+       "How fast the person's velocity toward the robot may grow while it brakes (turning into "
+       "it, stopping in front of it). 0: they keep their velocity.",
+       FIELD(closing_speed.person_accel_mps2),
+       0.0,
+       20.0,
        {}},
       {"closing_speed.reaction_time_s",
        "s",

@@ -36,16 +36,54 @@ TEST(ClosingSpeed, OffLeavesTheCommandAlone) {
   EXPECT_DOUBLE_EQ(r.u.wz, 0.3);
 }
 
+// The robot's way to a stop from v plus the person's way toward it meanwhile.
+double closed_in_a_stop(double v, double receding, double speed, const ClosingSpeedConfig& c) {
+  const double stop_s = c.reaction_time_s + v / c.robot_decel_mps2;
+  return v * c.reaction_time_s + v * v / (2.0 * c.robot_decel_mps2) +
+         core::person_approach_m(stop_s, receding, speed, c.person_accel_mps2);
+}
+
 TEST(ClosingSpeed, TheLimitStopsInTheGapLeft) {
   const ClosingSpeedConfig c = on(1.0);
   for (const double gap : {0.15, 0.3, 0.6, 1.2}) {
-    const double v = core::max_closing_speed(gap, 0.0, c);
+    const double v = core::max_closing_speed(gap, 0.0, 0.0, c);  // a person standing still
     // reaction, then braking: exactly the room between the bodies less the margin
     EXPECT_NEAR(v * c.reaction_time_s + v * v / (2.0 * c.robot_decel_mps2), gap - c.margin_m, 1e-9)
         << gap;
   }
-  EXPECT_DOUBLE_EQ(core::max_closing_speed(c.margin_m, 0.0, c), 0.0);
-  EXPECT_DOUBLE_EQ(core::max_closing_speed(-0.2, 0.0, c), 0.0) << "overlapping: never closer";
+  EXPECT_DOUBLE_EQ(core::max_closing_speed(c.margin_m, 0.0, 0.0, c), 0.0);
+  EXPECT_DOUBLE_EQ(core::max_closing_speed(-0.2, 0.0, 0.0, c), 0.0) << "overlapping: never closer";
+}
+
+TEST(ClosingSpeed, APersonWalkingAwayMayStopAndOneWalkingAcrossMayTurnIntoTheRobot) {
+  // straight away at 1.4 m/s, stopping at 3 m/s^2: 0.33 m farther, then standing
+  EXPECT_NEAR(core::person_approach_m(0.2, 1.4, 1.4, 3.0), -1.4 * 0.2 + 1.5 * 0.04, 1e-12);
+  EXPECT_NEAR(core::person_approach_m(2.0, 1.4, 1.4, 3.0), -1.4 * 1.4 / 6.0, 1e-12);
+  // across at 1.2 m/s: turning into the robot, at most at their speed
+  EXPECT_NEAR(core::person_approach_m(0.2, 0.0, 1.2, 3.0), 1.5 * 0.04, 1e-12);
+  EXPECT_NEAR(core::person_approach_m(2.0, 0.0, 1.2, 3.0), 0.24 + 1.2 * 1.6, 1e-12);
+  // toward it: from their speed on
+  EXPECT_NEAR(core::person_approach_m(0.5, -1.0, 1.0, 3.0), 0.5, 1e-12);
+  // no turning allowed: their velocity as it is
+  EXPECT_NEAR(core::person_approach_m(1.0, 0.7, 1.0, 0.0), -0.7, 1e-12);
+}
+
+TEST(ClosingSpeed, CountsThePersonsVelocityAndThatTheyMayTurnIntoTheRobot) {
+  const ClosingSpeedConfig c = on(1.0);  // person_accel_mps2 3
+  for (const double receding : {-0.5, 0.0, 0.6, 1.4}) {
+    const double v = core::max_closing_speed(0.5, receding, 1.4, c);
+    ASSERT_GT(v, 0.0) << receding;
+    EXPECT_NEAR(closed_in_a_stop(v, receding, 1.4, c), 0.5 - c.margin_m, 1e-9) << receding;
+  }
+  const double standing = core::max_closing_speed(0.5, 0.0, 0.0, c);
+  // behind a person walking away at 1.4 m/s the robot may close faster than on one standing
+  // (they would take 0.33 m to stop); beside one walking across, far slower (they may turn into
+  // it); on one coming toward it, slower again
+  EXPECT_GT(core::max_closing_speed(0.5, 1.4, 1.4, c), standing + 0.2);
+  EXPECT_LT(core::max_closing_speed(0.5, 0.0, 1.4, c), 0.6 * standing);
+  EXPECT_LT(core::max_closing_speed(0.5, -0.5, 1.4, c), core::max_closing_speed(0.5, 0.0, 1.4, c));
+  // a person coming fast and close: no closing speed at all (and never a negative one)
+  EXPECT_DOUBLE_EQ(core::max_closing_speed(0.15, -1.5, 1.5, c), 0.0);
 }
 
 TEST(ClosingSpeed, SlowsOnlyThePartTowardThePerson) {
@@ -53,23 +91,22 @@ TEST(ClosingSpeed, SlowsOnlyThePartTowardThePerson) {
   const auto r = core::limit_closing_speed(ahead(0.3, c), {0, 0}, Twist{1.5, 0.4, 0}, c, kLimits);
   ASSERT_TRUE(r.limited);
   EXPECT_NEAR(r.gap_m, 0.3, 1e-12);
-  EXPECT_NEAR(r.u.vx, core::max_closing_speed(0.3, 0.0, c), 1e-12);
+  EXPECT_NEAR(r.u.vx, core::max_closing_speed(0.3, 0.0, 0.0, c), 1e-12);
   EXPECT_DOUBLE_EQ(r.u.vy, 0.4) << "the sideways part does not close on them";
   EXPECT_DOUBLE_EQ(r.u.wz, 0.0);
 }
 
-TEST(ClosingSpeed, APersonWalkingAwayIsCreditedTheWayTheyWouldTakeToStop) {
+TEST(ClosingSpeed, UsesThePersonsVelocityAlongTheLineBetweenThem) {
   const ClosingSpeedConfig c = on(1.0);
-  const double standing = core::max_closing_speed(0.3, 0.0, c);
-  const auto r = core::limit_closing_speed(ahead(0.3, c), {1.4, 0.0}, Twist{1.5, 0, 0}, c, kLimits);
-  EXPECT_GT(r.max_closing_mps, standing + 0.3);
-  // robot: v t + v^2 / 2 a_r; person: 1.4^2 / 2 a_p
-  const double v = r.max_closing_mps;
-  EXPECT_NEAR(v * c.reaction_time_s + v * v / 2.0, 0.3 - c.margin_m + 1.4 * 1.4 / (2 * 3.0), 1e-9);
-  // walking toward the robot gives no credit and takes none: the limit is the standing one
+  const auto away =
+      core::limit_closing_speed(ahead(0.3, c), {1.4, 0.3}, Twist{1.5, 0, 0}, c, kLimits);
+  EXPECT_NEAR(away.max_closing_mps, core::max_closing_speed(0.3, 1.4, std::hypot(1.4, 0.3), c),
+              1e-12);
   const auto toward =
-      core::limit_closing_speed(ahead(0.3, c), {-1.4, 0.0}, Twist{1.5, 0, 0}, c, kLimits);
-  EXPECT_NEAR(toward.max_closing_mps, standing, 1e-12);
+      core::limit_closing_speed(ahead(0.3, c), {-0.5, 0.3}, Twist{1.5, 0, 0}, c, kLimits);
+  EXPECT_NEAR(toward.max_closing_mps, core::max_closing_speed(0.3, -0.5, std::hypot(0.5, 0.3), c),
+              1e-12);
+  EXPECT_LT(toward.u.vx, away.u.vx);
 }
 
 TEST(ClosingSpeed, NeverTurnsACommandIntoMotionAway) {

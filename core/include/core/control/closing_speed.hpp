@@ -6,10 +6,13 @@
 //          (a circle), less `margin_m`;
 //   n: the unit direction from the footprint's nearest point to the person's centre;
 //   v_r: that point's velocity toward the person, n . (v + w x r), linear in the command;
-//   v_p: the person's velocity away from the robot, n . v_person, counted only when >= 0;
-//   the robot stops in v_r t_r + v_r^2 / (2 a_r) (reaction time, then braking at a_r);
-//   the person, if they stop, in v_p^2 / (2 a_p);
-//   limit: v_r t_r + v_r^2 / (2 a_r) <= D + v_p^2 / (2 a_p).
+//   v_p: the person's velocity away from the robot, n . v_person (negative: toward it); their
+//        speed toward the robot, -v_p, may grow at a_h (turning into it, stopping) up to what
+//        they do not already spend walking away: |v_person| - max(v_p, 0) (one walking
+//        straight away may stop, not come back; one walking across may turn into the robot);
+//   the robot stops in T = t_r + v_r / a_r (reaction time, then braking at a_r), having moved
+//   v_r t_r + v_r^2 / (2 a_r); the person meanwhile comes closer by the integral of the above;
+//   limit: the sum of the two <= D (convex in v_r: the largest root, by bisection).
 // The limit is never negative, so a command is only ever slowed, never turned into motion
 // away: standing still always satisfies it (the person who walks toward a standing robot is
 // theirs to avoid, as with any obstacle; the DCBF keeps the robot out of their ellipse).
@@ -27,10 +30,12 @@ struct Footprint {
 };
 
 struct ClosingSpeedConfig {
-  double robot_decel_mps2 = 0;     // a_r; 0 = off
-  double person_decel_mps2 = 3.0;  // a_p: how hard the person is assumed to be able to stop
-  double reaction_time_s = 0.05;   // t_r: command latency and the control period
-  double margin_m = 0.10;          // gap left between the bodies after a stop
+  double robot_decel_mps2 = 0;  // a_r; 0 = off
+  // a_h: how fast the person's velocity toward the robot may grow (turning into it, stopping in
+  // front of it); 3 m/s^2 is a walking person's lateral acceleration in a quick turn.
+  double person_accel_mps2 = 3.0;
+  double reaction_time_s = 0.05;  // t_r: command latency and the control period
+  double margin_m = 0.10;         // gap left between the bodies after a stop
   double person_radius_m = 0.25;
   Footprint footprint;
 };
@@ -43,8 +48,14 @@ struct ClosingSpeedResult {
   double max_closing_mps = 0;  // what the limit allows
 };
 
+// How much closer the person comes in `time_s` (m; negative: farther), walking away from the
+// robot at `receding_mps` (negative: toward it) at `speed_mps` in all, turning toward it at up to
+// `accel_mps2`.
+double person_approach_m(double time_s, double receding_mps, double speed_mps, double accel_mps2);
+
 // The largest speed toward the person that still stops in time (>= 0).
-double max_closing_speed(double gap_m, double person_receding_mps, const ClosingSpeedConfig& c);
+double max_closing_speed(double gap_m, double receding_mps, double speed_mps,
+                         const ClosingSpeedConfig& c);
 
 // `person_in_base` and `person_velocity_in_base` (the person's own velocity, base_link axes).
 ClosingSpeedResult limit_closing_speed(const Point2& person_in_base,

@@ -152,7 +152,7 @@ struct DaemonConfig {
 
   struct ClosingSpeed {
     double robot_decel_mps2 = 0;  // 0: off
-    double person_decel_mps2 = 0;
+    double person_accel_mps2 = 0;
     double reaction_time_s = 0;
     double margin_m = 0;
     double person_radius_m = 0;
