@@ -9,6 +9,7 @@
 #include <random>
 #include <vector>
 
+#include "core/control/closing_speed.hpp"
 #include "core/control/mppi.hpp"
 #include "core/perception/costmap.hpp"
 #include "core/perception/voxel_grid.hpp"
@@ -109,6 +110,26 @@ void BM_InteractiveSpaceSelect(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_InteractiveSpaceSelect);
+
+// The closing-speed limit on the repaired command (a bisection of the stopping condition), for
+// a person at a spread of places and velocities around the robot.
+void BM_ClosingSpeedLimit(benchmark::State& state) {
+  core::ClosingSpeedConfig c;
+  c.robot_decel_mps2 = 1.0;
+  const core::TwistLimits limits;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> pos(-1.5, 1.5), vel(-1.5, 1.5);
+  std::vector<std::array<double, 4>> people(256);
+  for (auto& p : people)
+    p = {pos(rng), pos(rng), vel(rng), vel(rng)};
+  size_t i = 0;
+  for (auto _ : state) {
+    const auto& p = people[i++ & 255U];
+    benchmark::DoNotOptimize(core::limit_closing_speed({p[0], p[1]}, {p[2], p[3]},
+                                                       core::Twist{1.4, 0.3, 0.5}, c, limits));
+  }
+}
+BENCHMARK(BM_ClosingSpeedLimit);
 
 // The paper's policy step: W, P, G, the observation (layout 1, 716 floats) and the MLP
 // 716 -> 256 -> 128 -> 64 -> 64 (ReLU), masked argmax. Random weights: the cost is the same.
