@@ -1,7 +1,7 @@
 #pragma once
 // Speed and separation monitoring toward the followed person (after ISO/TS 15066's SSM): the
 // robot never moves toward the person faster than it can stop from before its footprint
-// reaches them, if they stopped too.
+// reaches them, counting how they may move toward it meanwhile.
 //   gap D: the distance from the robot's footprint (a box in base_link) to the person's body
 //          (a circle), less `margin_m`;
 //   n: the unit direction from the footprint's nearest point to the person's centre;
