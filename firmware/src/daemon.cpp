@@ -553,9 +553,9 @@ bool Daemon::run_controller(Nanos now, core::BodyVelocity& requested) {
   const core::Pose2 robot =
       b.odom * core::Pose2{b.vx_mps * lag_s, b.vy_mps * lag_s, b.wz_radps * lag_s};
   // The person for the barrier: constant velocity, the conservative prediction of where they
-  // may be. q^d, the point to be at, walks with them; with human.prediction_time_constant_s on
-  // a fading velocity that keeps it on the costmap (at constant velocity, the default, it runs
-  // ~15 m ahead over the 10 s horizon, off the map; why that is still the default: EVALUATION.md).
+  // may be. q^d, the point to be at, walks with them on a velocity that fades with
+  // human.prediction_time_constant_s (2 s by default), so it stays on the costmap; at constant
+  // velocity (0) it runs ~15 m ahead over the 10 s horizon, off the map (docs/EVALUATION.md).
   core::predict_path(track->value, now, mppi_.config().step_s, 0.0, person_path_);
   if (human_config_.prediction_time_constant_s > 0.0) {
     core::predict_path(track->value, now, mppi_.config().step_s,
@@ -593,7 +593,6 @@ bool Daemon::run_controller(Nanos now, core::BodyVelocity& requested) {
   }
   control_state_.repaired = out.repaired;
   if (out.repaired) ++control_state_.repairs;
-  control_state_.closing_limited = out.closing_limited;
   if (out.closing_limited) ++control_state_.closing_limits;
   control_state_.min_cost = out.min_cost;
   control_state_.best_cost = out.best;

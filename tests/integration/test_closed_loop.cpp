@@ -338,7 +338,7 @@ TEST(ClosedLoop, TheClosingSpeedLimitKeepsACatchingUpRobotOffATurningPerson) {
   // Random benchmark seed 25 with q^d on the faded prediction (tight tracking): the robot,
   // catching up from behind-right at ~1.75 m/s with q^d 0.7 m to the person's right, meets
   // their 65-degree right turn at 7.3 s and, braking at the base's 1.5 m/s^2, drives into their
-  // side at 7.8 s (docs/EVALUATION.md). closing_speed.* keeps its speed toward them within what
+  // side at 7.9 s (docs/EVALUATION.md). closing_speed.* keeps its speed toward them within what
   // it can stop from in the gap between the bodies. (The whole 60 s trial still touches them
   // at 11.5 s, where they cut across its path within its braking distance: not this test's.)
   auto run = [](double robot_decel_mps2, uint64_t& limited) {

@@ -49,6 +49,7 @@ ClosingSpeedResult limit_closing_speed(const Point2& person_in_base,
                                        const ClosingSpeedConfig& c, const TwistLimits& limits) {
   ClosingSpeedResult out;
   out.u = u;
+  if (c.robot_decel_mps2 <= 0.0) return out;  // off
   const Footprint& f = c.footprint;
   // The footprint's point nearest the person, and the direction from it to them.
   const Point2 near{std::clamp(person_in_base.x_m, f.x_min_m, f.x_max_m),
@@ -79,7 +80,7 @@ ClosingSpeedResult limit_closing_speed(const Point2& person_in_base,
   const double speed = std::hypot(person_velocity_in_base.x_m, person_velocity_in_base.y_m);
   out.max_closing_mps = max_closing_speed(out.gap_m, receding, speed, c);
   out.closing_mps = closing(u);
-  if (c.robot_decel_mps2 <= 0.0 || out.closing_mps <= out.max_closing_mps) return out;
+  if (out.closing_mps <= out.max_closing_mps) return out;
 
   out.limited = true;
   const double excess = (out.closing_mps - out.max_closing_mps) / (g0 * g0 + g1 * g1 + g2 * g2);

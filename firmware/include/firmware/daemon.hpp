@@ -111,12 +111,11 @@ struct ControlStatus {
   double min_cost = 0;             // the best rollout's cost
   core::MppiCostTerms best_cost;   // ... by term (why the robot leaves q^d: collision, barrier)
   double effective_samples = 0;
-  uint64_t runs = 0;             // MPPI steps so far
-  uint64_t failures = 0;         // MPPI steps that failed
-  uint64_t repairs = 0;          // first controls the QP repair changed
-  bool closing_limited = false;  // the latest command was slowed toward the person
-  uint64_t closing_limits = 0;   // commands slowed toward the person (closing_speed.*)
-  core::BodyVelocity command;    // after the supervisor's gate (what went to the base)
+  uint64_t runs = 0;            // MPPI steps so far
+  uint64_t failures = 0;        // MPPI steps that failed
+  uint64_t repairs = 0;         // first controls the QP repair changed
+  uint64_t closing_limits = 0;  // commands slowed toward the person (closing_speed.*)
+  core::BodyVelocity command;   // after the supervisor's gate (what went to the base)
 };
 
 // "front", "left", "behind", "right" of the person, from the design point's angle.
