@@ -55,7 +55,7 @@ TEST(InteractiveSpace, PointsLieOnTheEllipseAroundThePersonInBaseLink) {
   EXPECT_NEAR(c[1].dist_robot_m, 1.3, 1e-12);
   EXPECT_NEAR(c[1].dist_human_m, 0.7, 1e-12);
   // G = alpha |P - q_h| + beta |P| + gamma l
-  EXPECT_NEAR(c[1].objective, 1.0 * 0.7 + 0.5 * 1.3 + 0.02 * 0.0, 1e-12);
+  EXPECT_NEAR(c[1].objective, cfg.alpha * 0.7 + cfg.beta * 1.3 + cfg.gamma * 0.0, 1e-12);
   // With the robot elsewhere in odom, the costmap is looked up at the odom position.
   w.update(core::Pose2{2.0, 0.0, pi / 2}, core::Pose2{1.0, 1.0, pi}, room(std::nullopt));
   EXPECT_NEAR(w.candidates()[1].odom.x_m, 1.0 - 1.3, 1e-12);
@@ -84,6 +84,25 @@ TEST(InteractiveSpace, PExcludesPointsInObstaclesAndArgminPicksTheOpenSide) {
   const auto s2 = core::select_by_objective(open);
   EXPECT_EQ(s1.index, s2.index);
   EXPECT_EQ(open.free_count(), 64U);
+}
+
+TEST(InteractiveSpace, DefaultWeightsSendALaggingRobotBehindThePersonNotBesideThem) {
+  // The robot lags 2.5 m behind a person walking along +x, 0.9 m to their right. The weights
+  // (beta = 4 against alpha = 1, chosen on validation seeds: docs/EVALUATION.md) make G prefer
+  // the ellipse point nearest the robot over the short distance to the person beside them: the
+  // robot closes in behind, where the closing-speed limit can brake for a person who turns,
+  // instead of cutting across to their side (beta = 0.5 chose 0.49 m to the side here).
+  const core::InteractiveSpaceConfig cfg;
+  core::InteractiveSpace w(cfg);
+  const core::Pose2 person{2.5, 0.9, 0.0};
+  w.update(person, core::Pose2{}, room(std::nullopt));
+  const auto s = core::select_by_objective(w);
+  ASSERT_EQ(s.status, core::GoalStatus::kOk);
+  const double behind_m = person.x_m - s.goal_base.x_m;
+  const double aside_m = person.y_m - s.goal_base.y_m;
+  EXPECT_GT(behind_m, 0.9) << "behind the person, near the ellipse's a = 1 m";
+  EXPECT_LT(std::abs(aside_m), 0.3) << "near straight behind, not beside";
+  EXPECT_GT(aside_m, 0.0) << "on the robot's side of the person's track";
 }
 
 // A ring of obstacles 0.9 m around (cx, 0) (a crowd): every ellipse point there is too close.

@@ -24,7 +24,7 @@ struct InteractiveSpaceConfig {
   double b_m = 0.7;              // semi-axis to the person's side
   double cost_threshold = 30.0;  // R: a point with l(q) >= R is not in P
   double alpha = 1.0;            // weight of the distance to the person
-  double beta = 0.5;             // weight of the distance to the robot
+  double beta = 4.0;             // weight of the distance to the robot (= the shipped yaml)
   double gamma = 0.02;           // weight of the costmap cost
 };
 
