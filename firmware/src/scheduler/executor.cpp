@@ -1,5 +1,7 @@
 #include "firmware/scheduler/executor.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <latch>
 #include <numeric>
@@ -85,6 +87,11 @@ void Executor::start(core::Nanos origin, bool realtime) {
     }
     if (!members.empty()) plan.emplace_back(g, std::move(members));
   }
+  // spdlog's registry (the default logger) is created on first use; have that happen here, before
+  // any task thread exists, not in whichever two threads log first (libspdlog is not built with
+  // ThreadSanitizer, which then cannot see the static's guard and reports the first logs of the
+  // task threads as a race).
+  (void)spdlog::default_logger_raw();
   // Attach every thread before the first one exists, so a simulated clock cannot advance while
   // some group thread has not reached its first sleep yet.
   for (size_t k = 0; k < plan.size(); ++k)
