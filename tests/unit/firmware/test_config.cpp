@@ -223,4 +223,13 @@ TEST(Config, ControllerParametersComeFromTheConfigurationAsInThePaper) {
   const auto w = firmware::interactive_space_config(*firmware::load_default_config().config);
   EXPECT_EQ(w.points, 64);
   EXPECT_DOUBLE_EQ(w.cost_threshold, 30.0);
+  // The shipped weights of G are the core defaults, whose behaviour test_interactive_space pins
+  // (InteractiveSpace.DefaultWeightsSendALaggingRobotBehindThePersonNotBesideThem): changing
+  // either alone fails here.
+  const core::InteractiveSpaceConfig core_defaults;
+  EXPECT_DOUBLE_EQ(w.alpha, core_defaults.alpha);
+  EXPECT_DOUBLE_EQ(w.beta, core_defaults.beta);
+  EXPECT_DOUBLE_EQ(w.gamma, core_defaults.gamma);
+  EXPECT_DOUBLE_EQ(w.a_m, core_defaults.a_m);
+  EXPECT_DOUBLE_EQ(w.b_m, core_defaults.b_m);
 }
