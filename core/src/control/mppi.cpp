@@ -32,6 +32,7 @@ Mppi::Mppi(const MppiConfig& config)
     : cfg_(config),
       mean_(static_cast<size_t>(config.horizon_steps)),
       scratch_(mean_.size()),
+      update_(mean_.size()),
       pool_(kPoolSize),
       offset_((static_cast<size_t>(config.samples) + kLanes - 1) / kLanes),
       cost_(offset_.size() * kLanes),
@@ -207,7 +208,7 @@ void Mppi::rollout_block(size_t block, const MppiInputs& in) {
     }
     if (with_map) {
       for (size_t j = 0; j < kL; ++j) {
-        if (in.costmap->cost(x[j], y[j]) >= cfg_.cost_threshold) {
+        if (in.costmap->cost_at_least(x[j], y[j], cfg_.cost_threshold)) {
           cost[j] += collision;
           col[j] += collision;
         }
@@ -329,17 +330,24 @@ MppiOutput Mppi::step(const MppiInputs& in) {
     // the total weight with M = 2000).
     if (weight_[m] >= 1e-6) active_.push_back(static_cast<uint32_t>(m));
   }
-  for (size_t k = 0; k < mean_.size(); ++k) {
-    double d0 = 0, d1 = 0, d2 = 0;
-    for (const uint32_t m : active_) {
-      d0 += weight_[m] * static_cast<double>(pool_[noise_index(m, k, 0)]);
-      d1 += weight_[m] * static_cast<double>(pool_[noise_index(m, k, 1)]);
-      d2 += weight_[m] * static_cast<double>(pool_[noise_index(m, k, 2)]);
+  // Sample by sample (each sample's noise lies in one small stretch of the pool, so it is read
+  // from cache; step by step it was a cache miss per sample), the sums still in ascending m.
+  std::fill(update_.begin(), update_.end(), Twist{});
+  for (const uint32_t m : active_) {
+    const double w = weight_[m];
+    for (size_t k = 0; k < mean_.size(); ++k) {
+      Twist& d = update_[k];
+      d.vx += w * static_cast<double>(pool_[noise_index(m, k, 0)]);
+      d.vy += w * static_cast<double>(pool_[noise_index(m, k, 1)]);
+      d.wz += w * static_cast<double>(pool_[noise_index(m, k, 2)]);
     }
+  }
+  for (size_t k = 0; k < mean_.size(); ++k) {
+    const Twist& d = update_[k];
     Twist& mu = mean_[k];
-    mu = clip(
-        Twist{mu.vx + cfg_.sigma[0] * d0, mu.vy + cfg_.sigma[1] * d1, mu.wz + cfg_.sigma[2] * d2},
-        cfg_.limits);
+    mu = clip(Twist{mu.vx + cfg_.sigma[0] * d.vx, mu.vy + cfg_.sigma[1] * d.vy,
+                    mu.wz + cfg_.sigma[2] * d.wz},
+              cfg_.limits);
   }
   if (cfg_.smooth && mean_.size() >= 3) {
     scratch_ = mean_;

@@ -49,12 +49,15 @@ void edt_1d(const float* f, float* d, int n, int* v, float* z) {
 Costmap::Costmap(int cells, double resolution_m)
     : n_(cells),
       res_(resolution_m),
+      inv_res_(1.0 / resolution_m),
       cost_(static_cast<size_t>(cells) * static_cast<size_t>(cells), 0),
       dist2_(cost_.size(), kInf),
       f_(static_cast<size_t>(cells)),
       g_(static_cast<size_t>(cells)),
       z_(static_cast<size_t>(cells) + 1),
-      v_(static_cast<size_t>(cells)) {}
+      v_(static_cast<size_t>(cells)) {
+  build_quad_ranges();
+}
 
 void Costmap::build(const VoxelGrid& grid, const CostmapConfig& config, Nanos stamp) {
   if (n_ != grid.cells_xy() || res_ != grid.resolution()) {
@@ -111,16 +114,31 @@ void Costmap::build(const VoxelGrid& grid, const CostmapConfig& config, Nanos st
     // d2 holds an exact integer (a sum of squared cell offsets): truncation is exact.
     cost_[c] = d2 <= limit ? lut_[static_cast<size_t>(d2)] : 0;
   }
+  build_quad_ranges();
+}
+
+void Costmap::build_quad_ranges() {
+  const auto stride = static_cast<size_t>(n_ + 1);
+  quad_range_.resize(stride * stride);
+  for (int j = -1; j < n_; ++j) {
+    for (int i = -1; i < n_; ++i) {
+      const uint8_t a = cell(i, j), b = cell(i + 1, j), c = cell(i, j + 1), d = cell(i + 1, j + 1);
+      quad_range_[static_cast<size_t>(j + 1) * stride + static_cast<size_t>(i + 1)] =
+          CellRange{std::min({a, b, c, d}), std::max({a, b, c, d})};
+    }
+  }
 }
 
 void Costmap::copy_cells_from(const Costmap& other) {
   n_ = other.n_;
   res_ = other.res_;
+  inv_res_ = other.inv_res_;
   ox_ = other.ox_;
   oy_ = other.oy_;
   stamp_ = other.stamp_;
   obstacles_ = other.obstacles_;
   cost_.assign(other.cost_.begin(), other.cost_.end());  // no allocation once sized
+  quad_range_.assign(other.quad_range_.begin(), other.quad_range_.end());
 }
 
 uint8_t Costmap::at(double x, double y) const {

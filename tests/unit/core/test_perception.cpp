@@ -405,6 +405,69 @@ TEST(Costmap, DistanceTransformIsExact) {
   }
 }
 
+// The controller's collision test (cost_at_least: a quad's cell range decides most points
+// without interpolating) gives exactly the answer of cost(x, y) >= threshold: everywhere on and
+// off the map, on cell centres and quad edges, at the thresholds where rounding could tell them
+// apart (a corner exactly at the threshold), for a map built again (ranges refreshed) and for a
+// snapshot's copy. A range that ignored the off-map corners, missed a rebuild or was not copied
+// with the cells would disagree here.
+TEST(Costmap, CollisionTestEqualsTheInterpolatedCostAgainstTheThreshold) {
+  auto cfg = small_grid();
+  cfg.size_xy_m = 4.0;
+  core::VoxelGrid g(cfg);
+  g.recentre(0, 0);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.95, 1.95);
+  auto scatter = [&](int count, Nanos t) {
+    std::vector<Ray> rays;
+    for (int i = 0; i < count; ++i)
+      rays.push_back(ray_to(u(rng), u(rng), 0.5, Point3{0, 0, 3.0}));
+    g.insert(rays, core::Pose2{10, 10, 0}, std::nullopt, t);
+  };
+  const core::CostmapConfig cc;
+  core::Costmap m;
+  core::Costmap empty;  // never built: no cells, everything off the map
+  std::uniform_real_distribution<double> anywhere(-2.6, 2.6);  // the map is +-2 m
+  std::uniform_int_distribution<int> cell_index(-3, 42);
+  std::uniform_int_distribution<int> quarter(0, 4);
+  const double thresholds[] = {30.0, 29.5, 30.5, 0.0, 1.0, 63.0, 99.0, 100.0, 100.5, -1.0};
+  size_t fast_true = 0, fast_false = 0;
+  auto check = [&](const core::Costmap& map, const char* what) {
+    for (int n = 0; n < 60000; ++n) {
+      double x = anywhere(rng), y = anywhere(rng);
+      if (n % 3 == 0) {  // on cell centres, edges and quarter points, where corners weigh 0 or 1
+        x = map.origin_x() + (cell_index(rng) + 0.25 * quarter(rng)) * map.resolution();
+        y = map.origin_y() + (cell_index(rng) + 0.25 * quarter(rng)) * map.resolution();
+      }
+      const double c = map.cost(x, y);
+      // Thresholds at the corner values themselves too (a quad with a corner exactly at it).
+      const double at_cell = map.at(x, y);
+      for (const double t : {thresholds[n % 10], at_cell, c}) {
+        const bool want = c >= t;
+        ASSERT_EQ(map.cost_at_least(x, y, t), want)
+            << what << " at " << x << "," << y << " t=" << t;
+        (want ? fast_true : fast_false) += 1;
+      }
+    }
+  };
+  scatter(25, 1s);
+  m.build(g, cc, 1s);
+  check(m, "built");
+  scatter(25, 2s);  // more obstacles: the ranges must follow the new cells
+  m.build(g, cc, 2s);
+  check(m, "rebuilt");
+  core::Costmap copy;
+  copy.copy_cells_from(m);
+  check(copy, "copied");
+  for (const double t : thresholds) {
+    EXPECT_EQ(empty.cost_at_least(0.0, 0.0, t), 100.0 >= t);
+    EXPECT_EQ(m.cost_at_least(std::nan(""), 0.0, t), m.cost(std::nan(""), 0.0) >= t);
+    EXPECT_EQ(m.cost_at_least(1e12, 0.0, t), m.cost(1e12, 0.0) >= t);
+  }
+  EXPECT_GT(fast_true, 10000U);  // both answers were exercised
+  EXPECT_GT(fast_false, 10000U);
+}
+
 }  // namespace
 
 #include "core/perception/deskew.hpp"

@@ -106,6 +106,7 @@ class Mppi {
   MppiConfig cfg_;
   std::vector<Twist> mean_;       // K controls
   std::vector<Twist> scratch_;    // K controls (shift / smoothing)
+  std::vector<Twist> update_;     // K: the weighted noise the mean moves by
   std::vector<float> pool_;       // standard normals
   std::vector<uint32_t> offset_;  // per block of kLanes samples: where its noise starts
   std::vector<double> cost_;      // per sample

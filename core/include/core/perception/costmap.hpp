@@ -48,8 +48,10 @@ class Costmap {
   // Bilinear interpolation between cell centres (for the controller's smooth cost). Inline: the
   // controller calls it 200 000 times per step.
   [[nodiscard]] double cost(double x, double y) const {
-    const double gx = (x - ox_) / res_ - 0.5;
-    const double gy = (y - oy_) / res_ - 0.5;
+    // Grid coordinates of (x, y) between cell centres (by the inverse resolution: a division
+    // would be the slowest instruction of the controller's hot loop).
+    const double gx = (x - ox_) * inv_res_ - 0.5;
+    const double gy = (y - oy_) * inv_res_ - 0.5;
     if (!(gx > -1e9 && gx < 1e9 && gy > -1e9 && gy < 1e9)) return kCostLethal;  // NaN or far
     const int i = floor_int(gx);
     const int j = floor_int(gy);
@@ -58,22 +60,55 @@ class Costmap {
     return (1 - fx) * (1 - fy) * cell(i, j) + fx * (1 - fy) * cell(i + 1, j) +
            (1 - fx) * fy * cell(i, j + 1) + fx * fy * cell(i + 1, j + 1);
   }
+  // cost(x, y) >= threshold, the same answer, mostly without interpolating (the controller's
+  // collision test, 200 000 per step): each quad of four neighbouring cell centres keeps its
+  // least and greatest cell, and a bilinear value is a convex combination of its quad's corners,
+  // so only a quad whose range straddles the threshold is interpolated. The margin covers the
+  // interpolation's rounding (a few ulp of 100), so the answer is exact, not approximately so.
+  [[nodiscard]] bool cost_at_least(double x, double y, double threshold) const {
+    const double gx = (x - ox_) * inv_res_ - 0.5;  // as cost(): the same quad, bit for bit
+    const double gy = (y - oy_) * inv_res_ - 0.5;
+    if (!(gx > -1e9 && gx < 1e9 && gy > -1e9 && gy < 1e9)) return kCostLethal >= threshold;
+    const int i = floor_int(gx);
+    const int j = floor_int(gy);
+    CellRange range{kCostLethal, kCostLethal};  // a quad wholly off the map: every corner lethal
+    if (i >= -1 && j >= -1 && i < n_ && j < n_) {
+      range = quad_range_[static_cast<size_t>(j + 1) * static_cast<size_t>(n_ + 1) +
+                          static_cast<size_t>(i + 1)];
+    }
+    if (range.max < threshold - kMargin) return false;
+    if (range.min > threshold + kMargin) return true;
+    return cost(x, y) >= threshold;
+  }
   [[nodiscard]] const std::vector<uint8_t>& data() const { return cost_; }
   [[nodiscard]] size_t obstacle_cells() const { return obstacles_; }
 
  private:
+  // Bounds the rounding of a bilinear value (a few ulp of 100) in the range tests.
+  static constexpr double kMargin = 1e-9;
   // floor() without the libm call (the controller looks the costmap up 200 000 times per step).
   static int floor_int(double v) {
     const auto i = static_cast<int>(v);
     return i - static_cast<int>(v < static_cast<double>(i));
   }
 
+  // The least and greatest cost of the four cells of the quad whose lower corner is cell (i, j),
+  // i, j in -1 .. n - 1 (cells off the map count as lethal, as cell() has them).
+  struct CellRange {
+    uint8_t min, max;
+  };
+  void build_quad_ranges();
+
   int n_ = 0;
   double res_ = 0.05;
+  double inv_res_ = 1.0 / 0.05;
   double ox_ = 0, oy_ = 0;
   Nanos stamp_{0};
   size_t obstacles_ = 0;
   std::vector<uint8_t> cost_;
+  // (n + 1) x (n + 1), row j + 1, column i + 1 (an empty map: its one quad, all off the map)
+  std::vector<CellRange> quad_range_ =
+      std::vector<CellRange>(1, CellRange{kCostLethal, kCostLethal});
   // distance transform work buffers
   std::vector<float> dist2_;
   std::vector<float> f_, g_, z_;
