@@ -126,6 +126,8 @@ core::MppiConfig mppi_config(const DaemonConfig& cfg) {
   c.min_effective_samples = static_cast<int>(m.min_effective_samples);
   c.sigma = {m.noise_vx_mps, m.noise_vy_mps, m.noise_wz_radps};
   c.q = {m.q_x, m.q_y, m.q_theta};
+  c.tracking_frame =
+      m.tracking_frame == "robot" ? core::TrackingFrame::kRobot : core::TrackingFrame::kGoal;
   c.terminal_weight = m.terminal_weight;
   c.collision_cost = m.collision_cost;
   c.cost_threshold = cfg.interactive_space.cost_threshold;

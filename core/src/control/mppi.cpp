@@ -118,15 +118,17 @@ void Mppi::rollout_block(size_t block, const MppiInputs& in) {
   const bool with_map = in.costmap != nullptr;
   const auto collision = static_cast<float>(cfg_.collision_cost);
 
-  // Tracking: the error in the frame of the goal at step k, the angle wrapped to (-pi, pi].
+  // Tracking: the error in the frame of the goal at step k (or of the robot at the start), the
+  // angle wrapped to (-pi, pi].
+  const bool robot_frame = cfg_.tracking_frame == TrackingFrame::kRobot;
   float gx = 0, gy = 0, gth = 0, cg = 1, sg = 0;
   auto goal_at = [&](size_t k) {
     const GoalFrame& g = goal_frames_[std::min(k, goal_frames_.size() - 1)];
     gx = static_cast<float>(g.x);
     gy = static_cast<float>(g.y);
     gth = static_cast<float>(g.theta);
-    cg = static_cast<float>(g.c);
-    sg = static_cast<float>(g.s);
+    cg = static_cast<float>(robot_frame ? robot_cos_ : g.c);
+    sg = static_cast<float>(robot_frame ? robot_sin_ : g.s);
   };
   auto tracking = [&](float px, float py, float pth) {
     const float dx = px - gx;

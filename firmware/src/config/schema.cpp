@@ -756,6 +756,16 @@ std::vector<FieldSpec> build() {
        0.0,
        1e6,
        {}},
+      {"mppi.tracking_frame",
+       "name",
+       "The frame the tracking error q - q^d is expressed in before Q weighs it (the paper leaves "
+       "it open). goal: q^d's, x along the person's heading (an error across their path costs "
+       "c_y). robot: the robot's at the start of the rollouts, the frame the evaluation reports "
+       "e_x, e_y in (an error across the robot's current heading costs c_y).",
+       FIELD(mppi.tracking_frame),
+       0,
+       0,
+       {"goal", "robot"}},
       {"mppi.collision_cost",
        "-",
        "c_collision: cost of a predicted state whose costmap cost is >= R (paper: 1000).",

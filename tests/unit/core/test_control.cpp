@@ -70,6 +70,28 @@ TEST(Mppi, ConvergesToAFixedGoal) {
   EXPECT_LT(std::sqrt(se_th / n), 0.06);
 }
 
+// Q weighs the error in a frame (mppi.tracking_frame): with only c_x set and the goal's heading
+// a quarter turn from the robot's (held: no yaw), the goal frame drives the robot to the goal's
+// y (along the goal's heading) and the robot frame to its x (along the robot's), each leaving
+// the other axis free.
+TEST(Mppi, TheTrackingFrameDecidesWhichErrorQWeighs) {
+  for (const auto frame : {core::TrackingFrame::kGoal, core::TrackingFrame::kRobot}) {
+    const bool robot = frame == core::TrackingFrame::kRobot;
+    SCOPED_TRACE(robot ? "robot frame" : "goal frame");
+    core::MppiConfig c = test_config();
+    c.q = {50.0, 0.0, 0.0};
+    c.limits.wz = 1e-3;  // the heading stays ~0: the robot's frame is odom's
+    c.tracking_frame = frame;
+    Loop loop(c);
+    const Pose2 goal{1.5, 1.5, std::numbers::pi / 2};
+    for (int i = 0; i < 400; ++i)
+      ASSERT_TRUE(loop.tick(goal, {}, nullptr).ok);
+    const double weighed = robot ? loop.robot.x_m : loop.robot.y_m;  // c_x's axis
+    EXPECT_NEAR(weighed, 1.5, 0.15);
+    EXPECT_NEAR(loop.robot.theta_rad, 0.0, 0.01);
+  }
+}
+
 TEST(Mppi, NeverEntersTheEllipseOfAPersonWalkingTowardTheRobot) {
   for (uint64_t seed = 1; seed <= 5; ++seed) {
     SCOPED_TRACE(seed);

@@ -213,6 +213,7 @@ TEST(Config, ControllerParametersComeFromTheConfigurationAsInThePaper) {
   EXPECT_EQ(c.samples, 2000);
   EXPECT_DOUBLE_EQ(c.lambda, 1.0);
   EXPECT_EQ(c.q, (std::array<double, 3>{50.0, 10.0, 20.0}));
+  EXPECT_EQ(c.tracking_frame, core::TrackingFrame::kGoal);
   EXPECT_DOUBLE_EQ(c.collision_cost, 1000.0);
   EXPECT_DOUBLE_EQ(c.cost_threshold, 30.0);
   EXPECT_DOUBLE_EQ(c.dcbf_delta, 0.5);
@@ -232,4 +233,12 @@ TEST(Config, ControllerParametersComeFromTheConfigurationAsInThePaper) {
   EXPECT_DOUBLE_EQ(w.gamma, core_defaults.gamma);
   EXPECT_DOUBLE_EQ(w.a_m, core_defaults.a_m);
   EXPECT_DOUBLE_EQ(w.b_m, core_defaults.b_m);
+}
+
+TEST(Config, TheTrackingFrameIsAChoiceThatReachesTheController) {
+  expect_error(load_config_text("mppi:\n  tracking_frame: odom\n", "test.yaml"), 2,
+               "mppi.tracking_frame", "not one of");
+  const auto r = load_config_text("mppi:\n  tracking_frame: robot\n", "test.yaml");
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(firmware::mppi_config(*r.config).tracking_frame, core::TrackingFrame::kRobot);
 }

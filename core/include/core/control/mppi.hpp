@@ -3,7 +3,8 @@
 //   state (x, y, theta), control (vx, vy, wz) in the body frame, Euler steps of dt:
 //     x += (vx cos th - vy sin th) dt,  y += (vx sin th + vy cos th) dt,  th += wz dt
 //   per step k: tracking (q_k - q^d_k)^T Q (q_k - q^d_k), the error expressed in the goal's frame
-//   (e_x along the goal heading, e_y across it, e_theta wrapped); c_collision when the costmap
+//   (e_x along the goal heading, e_y across it) or the robot's at the start (TrackingFrame),
+//   e_theta wrapped; c_collision when the costmap
 //   cost (bilinear) >= R; c_safe max((1 - delta) h_k - h_{k+1}, 0) with h the ellipse barrier
 //   around the person's PREDICTED pose at step k; the control cost lambda u^T Sigma^-1 eps;
 //   a terminal tracking cost at K. Sampled controls are limited to the velocity box and to what
@@ -25,6 +26,12 @@
 
 namespace core {
 
+// The frame the tracking error is expressed in before Q weighs it.
+enum class TrackingFrame {
+  kGoal,   // q^d's at each step: e_x along the goal's (the person's) heading
+  kRobot,  // the robot's at the start of the rollouts (base_link when planning)
+};
+
 struct MppiConfig {
   int horizon_steps = 100;  // K
   double step_s = 0.1;      // dt
@@ -35,7 +42,8 @@ struct MppiConfig {
   int min_effective_samples = 0;
   std::array<double, 3> sigma = {0.3, 0.3, 0.5};  // noise std of vx, vy, wz
   std::array<double, 3> q = {50.0, 10.0, 20.0};   // Q = diag(c_x, c_y, c_theta)
-  double terminal_weight = 2.0;                   // the terminal cost is this times Q's
+  TrackingFrame tracking_frame = TrackingFrame::kGoal;
+  double terminal_weight = 2.0;  // the terminal cost is this times Q's
   double collision_cost = 1000.0;
   double cost_threshold = 30.0;  // R
   double dcbf_delta = 0.5;

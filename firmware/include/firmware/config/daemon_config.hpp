@@ -136,6 +136,7 @@ struct DaemonConfig {
     double q_x = 0;
     double q_y = 0;
     double q_theta = 0;
+    std::string tracking_frame;  // goal, robot
     double collision_cost = 0;
     double noise_vx_mps = 0;
     double noise_vy_mps = 0;
