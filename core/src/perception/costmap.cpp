@@ -118,7 +118,7 @@ void Costmap::build(const VoxelGrid& grid, const CostmapConfig& config, Nanos st
 }
 
 void Costmap::build_quad_ranges() {
-  const auto stride = static_cast<size_t>(n_ + 1);
+  const size_t stride = static_cast<size_t>(n_) + 1;
   quad_range_.resize(stride * stride);
   for (int j = -1; j < n_; ++j) {
     for (int i = -1; i < n_; ++i) {
