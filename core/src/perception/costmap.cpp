@@ -49,7 +49,6 @@ void edt_1d(const float* f, float* d, int n, int* v, float* z) {
 Costmap::Costmap(int cells, double resolution_m)
     : n_(cells),
       res_(resolution_m),
-      inv_res_(1.0 / resolution_m),
       cost_(static_cast<size_t>(cells) * static_cast<size_t>(cells), 0),
       dist2_(cost_.size(), kInf),
       f_(static_cast<size_t>(cells)),
@@ -132,7 +131,6 @@ void Costmap::build_quad_ranges() {
 void Costmap::copy_cells_from(const Costmap& other) {
   n_ = other.n_;
   res_ = other.res_;
-  inv_res_ = other.inv_res_;
   ox_ = other.ox_;
   oy_ = other.oy_;
   stamp_ = other.stamp_;

@@ -48,10 +48,11 @@ class Costmap {
   // Bilinear interpolation between cell centres (for the controller's smooth cost). Inline: the
   // controller calls it 200 000 times per step.
   [[nodiscard]] double cost(double x, double y) const {
-    // Grid coordinates of (x, y) between cell centres (by the inverse resolution: a division
-    // would be the slowest instruction of the controller's hot loop).
-    const double gx = (x - ox_) * inv_res_ - 0.5;
-    const double gy = (y - oy_) * inv_res_ - 0.5;
+    // Grid coordinates of (x, y) between cell centres. (A division: multiplying by the inverse
+    // resolution is faster but differs in the last bit, which moved a point across a cell edge
+    // in 1 of 10 evaluation trials: results would no longer reproduce earlier runs.)
+    const double gx = (x - ox_) / res_ - 0.5;
+    const double gy = (y - oy_) / res_ - 0.5;
     if (!(gx > -1e9 && gx < 1e9 && gy > -1e9 && gy < 1e9)) return kCostLethal;  // NaN or far
     const int i = floor_int(gx);
     const int j = floor_int(gy);
@@ -66,8 +67,8 @@ class Costmap {
   // so only a quad whose range straddles the threshold is interpolated. The margin covers the
   // interpolation's rounding (a few ulp of 100), so the answer is exact, not approximately so.
   [[nodiscard]] bool cost_at_least(double x, double y, double threshold) const {
-    const double gx = (x - ox_) * inv_res_ - 0.5;  // as cost(): the same quad, bit for bit
-    const double gy = (y - oy_) * inv_res_ - 0.5;
+    const double gx = (x - ox_) / res_ - 0.5;  // as cost(): the same quad, bit for bit
+    const double gy = (y - oy_) / res_ - 0.5;
     if (!(gx > -1e9 && gx < 1e9 && gy > -1e9 && gy < 1e9)) return kCostLethal >= threshold;
     const int i = floor_int(gx);
     const int j = floor_int(gy);
@@ -101,7 +102,6 @@ class Costmap {
 
   int n_ = 0;
   double res_ = 0.05;
-  double inv_res_ = 1.0 / 0.05;
   double ox_ = 0, oy_ = 0;
   Nanos stamp_{0};
   size_t obstacles_ = 0;
