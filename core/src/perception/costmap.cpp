@@ -117,13 +117,32 @@ void Costmap::build(const VoxelGrid& grid, const CostmapConfig& config, Nanos st
 }
 
 void Costmap::build_quad_ranges() {
+  // Runs in the lidar task once per costmap (10 Hz; the controller reads it 200 000 times per
+  // step): the interior rows straight from the cells, the border (off-map corners) through cell().
   const size_t stride = static_cast<size_t>(n_) + 1;
   quad_range_.resize(stride * stride);
+  const auto n = static_cast<size_t>(n_);
+  auto generic = [&](int i, int j) {
+    const uint8_t a = cell(i, j), b = cell(i + 1, j), c = cell(i, j + 1), d = cell(i + 1, j + 1);
+    quad_range_[static_cast<size_t>(j + 1) * stride + static_cast<size_t>(i + 1)] =
+        CellRange{std::min({a, b, c, d}), std::max({a, b, c, d})};
+  };
   for (int j = -1; j < n_; ++j) {
-    for (int i = -1; i < n_; ++i) {
-      const uint8_t a = cell(i, j), b = cell(i + 1, j), c = cell(i, j + 1), d = cell(i + 1, j + 1);
-      quad_range_[static_cast<size_t>(j + 1) * stride + static_cast<size_t>(i + 1)] =
-          CellRange{std::min({a, b, c, d}), std::max({a, b, c, d})};
+    const bool interior_row = j >= 0 && j + 1 < n_;
+    if (!interior_row) {
+      for (int i = -1; i < n_; ++i)
+        generic(i, j);
+      continue;
+    }
+    generic(-1, j);
+    generic(n_ - 1, j);
+    const uint8_t* r0 = &cost_[static_cast<size_t>(j) * n];
+    const uint8_t* r1 = r0 + n;
+    CellRange* out = &quad_range_[static_cast<size_t>(j + 1) * stride + 1];
+    for (size_t i = 0; i + 1 < n; ++i) {
+      const uint8_t lo0 = std::min(r0[i], r0[i + 1]), lo1 = std::min(r1[i], r1[i + 1]);
+      const uint8_t hi0 = std::max(r0[i], r0[i + 1]), hi1 = std::max(r1[i], r1[i + 1]);
+      out[i] = CellRange{std::min(lo0, lo1), std::max(hi0, hi1)};
     }
   }
 }

@@ -372,17 +372,29 @@ TEST(Costmap, FollowsTheDocumentedMapping) {
   EXPECT_EQ(m.stamp(), 1s);
 }
 
-TEST(Costmap, DistanceTransformIsExact) {
+// A 4 m grid (0.1 m cells) centred on the origin, for obstacles scattered at random.
+core::VoxelGrid four_metre_grid() {
   auto cfg = small_grid();
   cfg.size_xy_m = 4.0;
   core::VoxelGrid g(cfg);
   g.recentre(0, 0);
-  std::mt19937 rng(3);
+  return g;
+}
+
+// `count` returns straight down at random places on the grid, marked at time t (the robot
+// elsewhere: no self filter).
+void scatter_obstacles(core::VoxelGrid& g, std::mt19937& rng, int count, Nanos t) {
   std::uniform_real_distribution<double> u(-1.95, 1.95);
   std::vector<Ray> rays;
-  for (int i = 0; i < 25; ++i)
+  for (int i = 0; i < count; ++i)
     rays.push_back(ray_to(u(rng), u(rng), 0.5, Point3{0, 0, 3.0}));
-  g.insert(rays, core::Pose2{10, 10, 0}, std::nullopt, 1s);  // robot elsewhere: no self filter
+  g.insert(rays, core::Pose2{10, 10, 0}, std::nullopt, t);
+}
+
+TEST(Costmap, DistanceTransformIsExact) {
+  core::VoxelGrid g = four_metre_grid();
+  std::mt19937 rng(3);
+  scatter_obstacles(g, rng, 25, 1s);
   core::CostmapConfig cc;
   cc.inscribed_radius_m = 0.0;
   cc.inflation_radius_m = 10.0;
@@ -412,18 +424,8 @@ TEST(Costmap, DistanceTransformIsExact) {
 // snapshot's copy. A range that ignored the off-map corners, missed a rebuild or was not copied
 // with the cells would disagree here.
 TEST(Costmap, CollisionTestEqualsTheInterpolatedCostAgainstTheThreshold) {
-  auto cfg = small_grid();
-  cfg.size_xy_m = 4.0;
-  core::VoxelGrid g(cfg);
-  g.recentre(0, 0);
+  core::VoxelGrid g = four_metre_grid();
   std::mt19937 rng(11);
-  std::uniform_real_distribution<double> u(-1.95, 1.95);
-  auto scatter = [&](int count, Nanos t) {
-    std::vector<Ray> rays;
-    for (int i = 0; i < count; ++i)
-      rays.push_back(ray_to(u(rng), u(rng), 0.5, Point3{0, 0, 3.0}));
-    g.insert(rays, core::Pose2{10, 10, 0}, std::nullopt, t);
-  };
   const core::CostmapConfig cc;
   core::Costmap m;
   core::Costmap empty;  // never built: no cells, everything off the map
@@ -450,10 +452,10 @@ TEST(Costmap, CollisionTestEqualsTheInterpolatedCostAgainstTheThreshold) {
       }
     }
   };
-  scatter(25, 1s);
+  scatter_obstacles(g, rng, 25, 1s);
   m.build(g, cc, 1s);
   check(m, "built");
-  scatter(25, 2s);  // more obstacles: the ranges must follow the new cells
+  scatter_obstacles(g, rng, 25, 2s);  // more obstacles: the ranges must follow the new cells
   m.build(g, cc, 2s);
   check(m, "rebuilt");
   core::Costmap copy;

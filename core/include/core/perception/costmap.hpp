@@ -48,18 +48,9 @@ class Costmap {
   // Bilinear interpolation between cell centres (for the controller's smooth cost). Inline: the
   // controller calls it 200 000 times per step.
   [[nodiscard]] double cost(double x, double y) const {
-    // Grid coordinates of (x, y) between cell centres. (A division: multiplying by the inverse
-    // resolution is faster but differs in the last bit, which moved a point across a cell edge
-    // in 1 of 10 evaluation trials: results would no longer reproduce earlier runs.)
-    const double gx = (x - ox_) / res_ - 0.5;
-    const double gy = (y - oy_) / res_ - 0.5;
-    if (!(gx > -1e9 && gx < 1e9 && gy > -1e9 && gy < 1e9)) return kCostLethal;  // NaN or far
-    const int i = floor_int(gx);
-    const int j = floor_int(gy);
-    const double fx = gx - i;
-    const double fy = gy - j;
-    return (1 - fx) * (1 - fy) * cell(i, j) + fx * (1 - fy) * cell(i + 1, j) +
-           (1 - fx) * fy * cell(i, j + 1) + fx * fy * cell(i + 1, j + 1);
+    double gx = 0, gy = 0;
+    if (!grid_coordinates(x, y, gx, gy)) return kCostLethal;
+    return bilinear(gx, gy);
   }
   // cost(x, y) >= threshold, the same answer, mostly without interpolating (the controller's
   // collision test, 200 000 per step): each quad of four neighbouring cell centres keeps its
@@ -67,19 +58,18 @@ class Costmap {
   // so only a quad whose range straddles the threshold is interpolated. The margin covers the
   // interpolation's rounding (a few ulp of 100), so the answer is exact, not approximately so.
   [[nodiscard]] bool cost_at_least(double x, double y, double threshold) const {
-    const double gx = (x - ox_) / res_ - 0.5;  // as cost(): the same quad, bit for bit
-    const double gy = (y - oy_) / res_ - 0.5;
-    if (!(gx > -1e9 && gx < 1e9 && gy > -1e9 && gy < 1e9)) return kCostLethal >= threshold;
+    double gx = 0, gy = 0;
+    if (!grid_coordinates(x, y, gx, gy)) return kCostLethal >= threshold;
     const int i = floor_int(gx);
     const int j = floor_int(gy);
     CellRange range{kCostLethal, kCostLethal};  // a quad wholly off the map: every corner lethal
     if (i >= -1 && j >= -1 && i < n_ && j < n_) {
-      range = quad_range_[static_cast<size_t>(j + 1) * static_cast<size_t>(n_ + 1) +
+      range = quad_range_[static_cast<size_t>(j + 1) * (static_cast<size_t>(n_) + 1) +
                           static_cast<size_t>(i + 1)];
     }
     if (range.max < threshold - kMargin) return false;
     if (range.min > threshold + kMargin) return true;
-    return cost(x, y) >= threshold;
+    return bilinear(gx, gy) >= threshold;
   }
   [[nodiscard]] const std::vector<uint8_t>& data() const { return cost_; }
   [[nodiscard]] size_t obstacle_cells() const { return obstacles_; }
@@ -87,6 +77,22 @@ class Costmap {
  private:
   // Bounds the rounding of a bilinear value (a few ulp of 100) in the range tests.
   static constexpr double kMargin = 1e-9;
+  // Grid coordinates of (x, y) between cell centres; false for NaN or far off the map. (A
+  // division: multiplying by the inverse resolution is faster but differs in the last bit, which
+  // moved a point across a cell edge in 1 of 10 evaluation trials.)
+  bool grid_coordinates(double x, double y, double& gx, double& gy) const {
+    gx = (x - ox_) / res_ - 0.5;
+    gy = (y - oy_) / res_ - 0.5;
+    return gx > -1e9 && gx < 1e9 && gy > -1e9 && gy < 1e9;
+  }
+  [[nodiscard]] double bilinear(double gx, double gy) const {
+    const int i = floor_int(gx);
+    const int j = floor_int(gy);
+    const double fx = gx - i;
+    const double fy = gy - j;
+    return (1 - fx) * (1 - fy) * cell(i, j) + fx * (1 - fy) * cell(i + 1, j) +
+           (1 - fx) * fy * cell(i, j + 1) + fx * fy * cell(i + 1, j + 1);
+  }
   // floor() without the libm call (the controller looks the costmap up 200 000 times per step).
   static int floor_int(double v) {
     const auto i = static_cast<int>(v);
