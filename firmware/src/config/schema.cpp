@@ -678,9 +678,10 @@ std::vector<FieldSpec> build() {
       {"objective.alpha",
        "1/m",
        "alpha: weight of the distance from a candidate to the person in G (not given in the "
-       "paper; chosen).",
+       "paper; chosen). Negative: G prefers the ellipse's far points, along the person's "
+       "heading (behind or ahead of them), over the near ones beside them.",
        FIELD(objective.alpha),
-       0.0,
+       -1000.0,
        1000.0,
        {}},
       {"objective.beta",

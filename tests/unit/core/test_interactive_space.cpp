@@ -180,3 +180,24 @@ TEST(GoalHold, NeverHoldsWithoutAPersonOrWithAZeroHold) {
 }
 
 }  // namespace
+
+TEST(InteractiveSpace, ANegativeAlphaPullsADiagonalFollowerTowardStraightBehind) {
+  // The robot follows 1.2 m behind and 0.6 m to the right of a person walking along +x. With
+  // alpha > 0, G trades the short distance to the person beside them against the robot's
+  // distance: q^d lands diagonally behind-right. alpha < 0 rewards the ellipse's far points
+  // (a = 1 m behind against b = 0.7 m beside): q^d moves toward the person's wake.
+  const core::Pose2 person{1.2, 0.6, 0.0};
+  auto aside_m = [&](double alpha) {
+    core::InteractiveSpaceConfig cfg;
+    cfg.alpha = alpha;
+    core::InteractiveSpace w(cfg);
+    w.update(person, core::Pose2{}, room(std::nullopt));
+    const auto s = core::select_by_objective(w);
+    EXPECT_EQ(s.status, core::GoalStatus::kOk);
+    EXPECT_LT(s.goal_base.x_m, person.x_m - 0.8) << "behind the person either way";
+    return person.y_m - s.goal_base.y_m;
+  };
+  EXPECT_GT(aside_m(1.0), 0.3) << "alpha = 1: diagonally behind-right";
+  EXPECT_LT(aside_m(-16.0), 0.25) << "alpha = -16: nearer straight behind";
+  EXPECT_GT(aside_m(-16.0), 0.0) << "still on the robot's side of the track";
+}

@@ -242,3 +242,13 @@ TEST(Config, TheTrackingFrameIsAChoiceThatReachesTheController) {
   ASSERT_TRUE(r.ok());
   EXPECT_EQ(firmware::mppi_config(*r.config).tracking_frame, core::TrackingFrame::kRobot);
 }
+
+TEST(Config, ANegativeAlphaIsAcceptedAndReachesTheSelector) {
+  // alpha < 0 makes G prefer the ellipse's far points (along the person's heading): an
+  // evaluated setting (docs/EVALUATION.md), so the schema must let it through, within bounds.
+  const auto r = load_config_text("objective:\n  alpha: -16.0\n", "test.yaml");
+  ASSERT_TRUE(r.ok());
+  EXPECT_DOUBLE_EQ(firmware::interactive_space_config(*r.config).alpha, -16.0);
+  expect_error(load_config_text("objective:\n  alpha: -1001.0\n", "test.yaml"), 2,
+               "objective.alpha", "out of range [-1000, 1000]");
+}
