@@ -8,7 +8,10 @@ Writes into OUT_DIR/plots/:
                          one panel per method (from trials.csv)
   trajectories-<case>.png  robot, person and chosen points of the first trial per method
   errors-<case>.png      e_x, e_y, e_theta over time (q^d - robot, robot frame), first trial
-The last two need the per-trial samples (companion-eval --samples).
+  sr-<group>.png         SR per method over a group's cases (crowds: pedestrians, with the
+                         paper's proposed method; speeds: m/s; sizes: a x b), when the
+                         directory has two or more cases of the group
+The trajectories and errors need the per-trial samples (companion-eval --samples).
 """
 import csv
 import math
@@ -51,6 +54,51 @@ def sides_plot(case, rows, out):
     fig.tight_layout()
     fig.savefig(out, dpi=110)
     plt.close(fig)
+
+
+# The paper's crowd-density SR of its proposed method (reference/evaluation.md).
+PAPER_CROWD_SR = {5: 81.0, 10: 65.0, 15: 33.0, 20: 26.0}
+GROUPS = {  # case prefix -> (file name, x-axis label, value of the case's suffix)
+    "crowd-": ("crowds", "pedestrians", int),
+    "speed-": ("speeds", "person's walking speed (m/s)", float),
+    "size-": ("sizes", "interaction space a x b (m)", str),
+}
+
+
+def success_rate(rows, case, method):
+    picked = [r for r in rows if r["case"] == case and r["method"] == method]
+    return 100.0 * sum(r["success"] == "1" for r in picked) / len(picked) if picked else None
+
+
+def sweep_plot(prefix, rows, out):
+    """SR of every method over the cases of one group; False when there is nothing to sweep."""
+    name, label, value = GROUPS[prefix]
+    cases = sorted({r["case"] for r in rows if r["case"].startswith(prefix)},
+                   key=lambda c: value(c[len(prefix):]) if value is not str else c)
+    if len(cases) < 2:
+        return False
+    xs = list(range(len(cases)))
+    fig, ax = plt.subplots(figsize=(5.6, 3.6))
+    for method in sorted({r["method"] for r in rows}):
+        ys = [success_rate(rows, c, method) for c in cases]
+        ax.plot(xs, [y if y is not None else math.nan for y in ys], marker="o", label=method)
+    if name == "crowds":
+        paper = [PAPER_CROWD_SR.get(int(c[len(prefix):]), math.nan) for c in cases]
+        ax.plot(xs, paper, "k--", marker="x", label="paper (RL + MPPI-CBF)")
+    trials = max(sum(1 for r in rows if r["case"] == c and r["method"] == rows[0]["method"])
+                 for c in cases)
+    ax.set_xticks(xs)
+    ax.set_xticklabels([c[len(prefix):] for c in cases])
+    ax.set_xlabel(label)
+    ax.set_ylabel("SR %")
+    ax.set_ylim(-5, 105)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title(f"{name}: success rate ({trials} trials per case and method)", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+    return True
 
 
 def first_samples(out_dir, case, rows):
@@ -131,6 +179,10 @@ def main():
                 path = os.path.join(plots, f"{name}-{case}.png")
                 fn(case, samples, path)
                 written.append(path)
+    for prefix, (name, _, _) in GROUPS.items():
+        path = os.path.join(plots, f"sr-{name}.png")
+        if sweep_plot(prefix, rows, path):
+            written.append(path)
     for p in written:
         print(p)
     return 0

@@ -51,7 +51,7 @@ for step in $steps; do
       ;;
   esac
 done
-for d in paper recorded-biwi_hotel recorded-crowds_zara01; do
+for d in paper variants recorded-biwi_hotel recorded-crowds_zara01; do
   if [[ -d "$out/$d" ]]; then /usr/bin/python3 sim/eval/plot_eval.py "$out/$d" >/dev/null; fi
 done
 

@@ -82,9 +82,12 @@ TEST(ClosedLoop, OpenSpaceKeepsThePersonWithinTheInteractionSpace) {
 
 TEST(ClosedLoop, SwitchesSidesAroundAStaticObstacle) {
   // The robot starts behind-right; the box on the person's right (x 6..10) leaves no free point
-  // there, so the chosen point moves to another side while passing it.
+  // there, so the chosen point moves to another side while passing it. With alpha = 1 (G pulled
+  // toward the person's near side): the shipped alpha < 0 keeps the robot straight behind here,
+  // where the box closes no point, so there would be no side to switch from.
   std::array<double, 8> before{}, passing{};
   auto o = scenario("static_obstacle");
+  o.config.objective.alpha = 1.0;
   o.script = [&](double, sim::SimWorld& w, firmware::Daemon& d) {
     const auto v = sim::daemon_view(d, w.robot_pose());
     if (!v.active || v.side < 0) return;
@@ -348,8 +351,10 @@ TEST(ClosedLoop, TheClosingSpeedLimitKeepsACatchingUpRobotOffATurningPerson) {
     o.seed = 25;
     o.duration_s = 10.0;
     o.config.human.prediction_time_constant_s = 2.0;
-    // The selector weights the situation was found with (objective.beta's default was 0.5; at
-    // 4.0 the robot stays nearer its own side of the ellipse and does not meet this turn).
+    // The selector weights the situation was found with (objective.alpha's default was 1 and
+    // beta's 0.5; at the shipped weights the robot stays nearer its own side of the ellipse, or
+    // straight behind, and does not meet this turn).
+    o.config.objective.alpha = 1.0;
     o.config.objective.beta = 0.5;
     o.config.closing_speed.robot_decel_mps2 = robot_decel_mps2;
     o.script = [&](double, sim::SimWorld&, firmware::Daemon& d) {

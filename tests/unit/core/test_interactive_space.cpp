@@ -88,8 +88,8 @@ TEST(InteractiveSpace, PExcludesPointsInObstaclesAndArgminPicksTheOpenSide) {
 
 TEST(InteractiveSpace, DefaultWeightsSendALaggingRobotBehindThePersonNotBesideThem) {
   // The robot lags 2.5 m behind a person walking along +x, 0.9 m to their right. The weights
-  // (beta = 4 against alpha = 1, chosen on validation seeds: docs/EVALUATION.md) make G prefer
-  // the ellipse point nearest the robot over the short distance to the person beside them: the
+  // (beta = 4, alpha = -16, chosen on validation seeds: docs/EVALUATION.md) make G prefer the
+  // ellipse point nearest the robot, and the far points, over the person's near side: the
   // robot closes in behind, where the closing-speed limit can brake for a person who turns,
   // instead of cutting across to their side (beta = 0.5 chose 0.49 m to the side here).
   const core::InteractiveSpaceConfig cfg;

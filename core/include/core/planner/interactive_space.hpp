@@ -23,7 +23,7 @@ struct InteractiveSpaceConfig {
   double a_m = 1.0;              // semi-axis along the person's heading
   double b_m = 0.7;              // semi-axis to the person's side
   double cost_threshold = 30.0;  // R: a point with l(q) >= R is not in P
-  double alpha = 1.0;            // weight of the distance to the person
+  double alpha = -16.0;          // weight of the distance to the person (< 0: the far points)
   double beta = 4.0;             // weight of the distance to the robot (= the shipped yaml)
   double gamma = 0.02;           // weight of the costmap cost
 };
