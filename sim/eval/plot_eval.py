@@ -66,8 +66,9 @@ GROUPS = {  # case prefix -> (file name, x-axis label, value of the case's suffi
 
 
 def success_rate(rows, case, method):
+    """SR % of one method in one case; NaN (a gap in the line) when it did not run there."""
     picked = [r for r in rows if r["case"] == case and r["method"] == method]
-    return 100.0 * sum(r["success"] == "1" for r in picked) / len(picked) if picked else None
+    return 100.0 * sum(r["success"] == "1" for r in picked) / len(picked) if picked else math.nan
 
 
 def sweep_plot(prefix, rows, out):
@@ -79,14 +80,14 @@ def sweep_plot(prefix, rows, out):
         return False
     xs = list(range(len(cases)))
     fig, ax = plt.subplots(figsize=(5.6, 3.6))
-    for method in sorted({r["method"] for r in rows}):
-        ys = [success_rate(rows, c, method) for c in cases]
-        ax.plot(xs, [y if y is not None else math.nan for y in ys], marker="o", label=method)
+    methods = sorted({r["method"] for r in rows})
+    for method in methods:
+        ax.plot(xs, [success_rate(rows, c, method) for c in cases], marker="o", label=method)
     if name == "crowds":
         paper = [PAPER_CROWD_SR.get(int(c[len(prefix):]), math.nan) for c in cases]
         ax.plot(xs, paper, "k--", marker="x", label="paper (RL + MPPI-CBF)")
-    trials = max(sum(1 for r in rows if r["case"] == c and r["method"] == rows[0]["method"])
-                 for c in cases)
+    trials = max(sum(1 for r in rows if r["case"] == c and r["method"] == m)
+                 for c in cases for m in methods)
     ax.set_xticks(xs)
     ax.set_xticklabels([c[len(prefix):] for c in cases])
     ax.set_xlabel(label)

@@ -77,10 +77,10 @@ TEST(CompanionEval, TheOneCommandBenchmarkWritesEveryTableAndPlot) {
   }
   // 7 paper cases + 10 variants + 2 recorded.
   EXPECT_NE(report.find("19 trials in"), std::string::npos) << report;
-  for (const char* f : {"/paper/plots/sides-random.png", "/paper/plots/trajectories-doorway.png",
-                        "/variants/plots/sr-crowds.png", "/variants/plots/sr-speeds.png",
-                        "/variants/plots/sr-sizes.png",
-                        "/recorded-biwi_hotel/plots/trajectories-recorded.png"}) {
+  for (const char* f :
+       {"/paper/plots/sides-random.png", "/paper/plots/trajectories-doorway.png",
+        "/variants/plots/sr-crowds.png", "/variants/plots/sr-speeds.png",
+        "/variants/plots/sr-sizes.png", "/recorded-biwi_hotel/plots/trajectories-recorded.png"}) {
     EXPECT_GT(slurp(out + f).size(), 1000U) << f;
   }
 }

@@ -179,8 +179,6 @@ TEST(GoalHold, NeverHoldsWithoutAPersonOrWithAZeroHold) {
             core::GoalStatus::kNoFreePoint);
 }
 
-}  // namespace
-
 TEST(InteractiveSpace, ANegativeAlphaPullsADiagonalFollowerTowardStraightBehind) {
   // The robot follows 1.2 m behind and 0.6 m to the right of a person walking along +x. With
   // alpha > 0, G trades the short distance to the person beside them against the robot's
@@ -201,3 +199,5 @@ TEST(InteractiveSpace, ANegativeAlphaPullsADiagonalFollowerTowardStraightBehind)
   EXPECT_LT(aside_m(-16.0), 0.25) << "alpha = -16: nearer straight behind";
   EXPECT_GT(aside_m(-16.0), 0.0) << "still on the robot's side of the track";
 }
+
+}  // namespace
