@@ -81,7 +81,23 @@ std::optional<std::vector<Case>> expand_cases(const std::string& name, int rando
     }
     return out;
   }
+  // Constrained worlds: the random world of the same seed with obstacles beside the walk, their
+  // surfaces C m from the person's path: where adaptive selection should pay.
+  auto clutter_case = [&](double clearance_m) {
+    Case c = random_case(fmt::format("clutter-{}", clearance_m));
+    c.random.beside_walk_clearance_m = clearance_m;
+    return c;
+  };
+  if (name == "constrained") {
+    for (double clearance_m : {1.2, 1.0, 0.8}) {
+      out.push_back(clutter_case(clearance_m));
+    }
+    return out;
+  }
   double v = 0;
+  if (name.rfind("clutter-", 0) == 0 && parse_number(name.substr(8), v) && v >= 0.6 && v <= 3) {
+    return std::vector<Case>{clutter_case(v)};
+  }
   if (name.rfind("crowd-", 0) == 0 && parse_number(name.substr(6), v) && v >= 0 && v <= 100) {
     Case c = random_case(name);
     c.random.pedestrians = static_cast<int>(v);
@@ -105,8 +121,8 @@ std::optional<std::vector<Case>> expand_cases(const std::string& name, int rando
   }
   error = fmt::format(
       "unknown case '{}': a scenario (open, static_obstacle, pedestrian_front_right, corridor, "
-      "doorway, crossing, random), a group (paper, crowds, speeds, sizes), or crowd-N, speed-V, "
-      "size-AxB",
+      "doorway, crossing, random), a group (paper, crowds, speeds, sizes, constrained), or "
+      "crowd-N, speed-V, size-AxB, clutter-C",
       name);
   return std::nullopt;
 }

@@ -30,8 +30,9 @@ struct Case {
 };
 
 // Case names: the built-ins (open ... crossing, random), "crowd-N", "speed-V", "size-AxB",
-// "paper" (scenarios 1-6 + random), "crowds" (5/10/15/20), "speeds" (0.75/1.2/1.7),
-// "sizes" (a few a x b). Unknown names: nullopt and `error`.
+// "clutter-C" (obstacles beside the walk, C m from it), "paper" (scenarios 1-6 + random),
+// "crowds" (5/10/15/20), "speeds" (0.75/1.2/1.7), "sizes" (a few a x b), "constrained"
+// (clutter 1.2/1.0/0.8). Unknown names: nullopt and `error`.
 std::optional<std::vector<Case>> expand_cases(const std::string& name, int random_trials,
                                               std::string& error);
 

@@ -9,8 +9,9 @@ Writes into OUT_DIR/plots/:
   trajectories-<case>.png  robot, person and chosen points of the first trial per method
   errors-<case>.png      e_x, e_y, e_theta over time (q^d - robot, robot frame), first trial
   sr-<group>.png         SR per method over a group's cases (crowds: pedestrians, with the
-                         paper's proposed method; speeds: m/s; sizes: a x b), when the
-                         directory has two or more cases of the group
+                         paper's proposed method; speeds: m/s; sizes: a x b; constrained:
+                         the obstacles' clearance from the walk), when the directory has two
+                         or more cases of the group
 The trajectories and errors need the per-trial samples (companion-eval --samples).
 """
 import csv
@@ -62,6 +63,7 @@ GROUPS = {  # case prefix -> (file name, x-axis label, value of the case's suffi
     "crowd-": ("crowds", "pedestrians", int),
     "speed-": ("speeds", "person's walking speed (m/s)", float),
     "size-": ("sizes", "interaction space a x b (m)", str),
+    "clutter-": ("constrained", "obstacles beside the walk, clearance (m)", float),
 }
 
 

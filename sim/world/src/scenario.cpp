@@ -98,6 +98,50 @@ double uniform(std::mt19937& rng, double a, double b) {
   return std::uniform_real_distribution<double>(a, b)(rng);
 }
 
+// The constrained worlds' obstacles beside the walk (RandomScenarioOptions), from their own
+// generator and after everything else, so the seed's world is unchanged beneath them.
+void add_obstacles_beside_walk(Scenario& s, uint32_t seed, double clearance_m) {
+  std::mt19937 rng(seed ^ 0x9E3779B9u);
+  const std::vector<TimedPose>& walk_samples = s.person.samples();
+  // Exact for both shapes: a box's corners are r sqrt(2) from its centre.
+  auto clear = [&](core::Point2 c, double bound_m) {
+    for (const TimedPose& tp : walk_samples) {
+      if (std::hypot(tp.pose.x_m - c.x_m, tp.pose.y_m - c.y_m) < bound_m + clearance_m) {
+        return false;
+      }
+    }
+    for (const Pedestrian& p : s.pedestrians) {
+      if (std::hypot(p.position.x_m - c.x_m, p.position.y_m - c.y_m) < bound_m + 0.6) return false;
+    }
+    return std::hypot(s.robot_start.x_m - c.x_m, s.robot_start.y_m - c.y_m) > bound_m + 1.5;
+  };
+  double walked_m = 0;
+  double next_m = uniform(rng, 1.0, 3.0);
+  for (size_t k = 1; k < walk_samples.size(); ++k) {
+    const core::Pose2& a = walk_samples[k - 1].pose;
+    const core::Pose2& b = walk_samples[k].pose;
+    walked_m += std::hypot(b.x_m - a.x_m, b.y_m - a.y_m);
+    if (walked_m < next_m) continue;
+    next_m = walked_m + uniform(rng, 2.0, 4.0);
+    const auto sides = rng() % 3;  // left, right, or both: a passage twice the clearance wide
+    for (const double side : {1.0, -1.0}) {
+      if ((sides == 0 && side < 0) || (sides == 1 && side > 0)) continue;
+      const double r = uniform(rng, 0.3, 0.8);
+      const bool box = rng() % 2 == 0;
+      const double bound_m = box ? r * std::numbers::sqrt2 : r;
+      const double off = clearance_m + bound_m + uniform(rng, 0.0, 0.3);
+      const core::Point2 c{b.x_m - side * off * std::sin(b.theta_rad),
+                           b.y_m + side * off * std::cos(b.theta_rad)};
+      if (!clear(c, bound_m)) continue;
+      if (box) {
+        s.world.add_box({c.x_m - r, c.y_m - r}, {c.x_m + r, c.y_m + r});
+      } else {
+        s.world.add_circle(c, r);
+      }
+    }
+  }
+}
+
 }  // namespace
 
 const std::vector<ScenarioInfo>& builtin_scenarios() {
@@ -158,6 +202,7 @@ Scenario random_scenario(uint32_t seed, const RandomScenarioOptions& o) {
     }
     return std::hypot(s.robot_start.x_m - c.x_m, s.robot_start.y_m - c.y_m) > r + 1.5;
   };
+
   for (int i = 0, tries = 0; i < o.obstacles && tries < 2000; ++tries) {
     const core::Point2 c{uniform(rng, -13, 13), uniform(rng, -13, 13)};
     const double r = uniform(rng, 0.3, 0.8);
@@ -183,6 +228,7 @@ Scenario random_scenario(uint32_t seed, const RandomScenarioOptions& o) {
     ped.radius_m = uniform(rng, 0.2, 0.35);
     s.pedestrians.push_back(ped);
   }
+  if (o.beside_walk_clearance_m > 0) add_obstacles_beside_walk(s, seed, o.beside_walk_clearance_m);
   return s;
 }
 

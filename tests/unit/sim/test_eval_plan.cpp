@@ -1,6 +1,9 @@
 // companion-eval's plan: case names -> world recipes, methods -> daemon configuration.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <utility>
+
 #include "eval_plan.hpp"
 #include "firmware/config/config_loader.hpp"
 
@@ -32,7 +35,15 @@ TEST(EvalPlan, GroupsExpandToTheReferenceCases) {
   EXPECT_EQ(size->front().ellipse_a_m, 1.2);
   EXPECT_EQ(size->front().ellipse_b_m, 0.9);
 
-  for (const char* bad : {"moon", "crowd-x", "speed-0", "size-1.2", "size-9x9", "crowd-1000"}) {
+  auto constrained = eval::expand_cases("constrained", 3, error);
+  ASSERT_TRUE(constrained);
+  ASSERT_EQ(constrained->size(), 3U);
+  EXPECT_EQ((*constrained)[1].name, "clutter-1");
+  EXPECT_EQ((*constrained)[1].random.beside_walk_clearance_m, 1.0);
+  EXPECT_EQ(paper->back().random.beside_walk_clearance_m, 0) << "the benchmark stays as it was";
+
+  for (const char* bad : {"moon", "crowd-x", "speed-0", "size-1.2", "size-9x9", "crowd-1000",
+                          "clutter-0.2", "clutter-", "clutter-1m"}) {
     EXPECT_FALSE(eval::expand_cases(bad, 3, error)) << bad;
     EXPECT_NE(error.find("unknown case"), std::string::npos);
   }
@@ -66,4 +77,47 @@ TEST(EvalPlan, RandomWorldsDifferBySeedAndRepeatForTheSameSeed) {
   EXPECT_NE(a.person.end_s(), b.person.end_s());
   EXPECT_EQ(a.person.end_s(), a2.person.end_s());
   EXPECT_EQ(a.world.segments.size(), a2.world.segments.size());
+}
+
+namespace {
+// The smallest distance from the person's walk to a static obstacle, and the share of the walk
+// where an obstacle is nearer than `closed_m` (the points beside the person closed).
+std::pair<double, double> walk_clearance(const sim::Scenario& s, double closed_m) {
+  double nearest = 1e9;
+  int closed = 0;
+  for (const sim::TimedPose& tp : s.person.samples()) {
+    const double d = s.world.distance({tp.pose.x_m, tp.pose.y_m});
+    nearest = std::min(nearest, d);
+    closed += d < closed_m ? 1 : 0;
+  }
+  return {nearest, static_cast<double>(closed) / static_cast<double>(s.person.samples().size())};
+}
+}  // namespace
+
+TEST(EvalPlan, ConstrainedWorldsAreTheSeedsWorldWithObstaclesBesideTheWalk) {
+  std::string error;
+  const auto open = eval::expand_cases("random", 1, error)->front();
+  const auto tight = eval::expand_cases("clutter-1.0", 1, error)->front();
+  double open_closed = 0, tight_closed = 0;
+  for (uint32_t seed = 1; seed <= 10; ++seed) {
+    const sim::Scenario a = eval::make_world(open, seed);
+    const sim::Scenario b = eval::make_world(tight, seed);
+    const auto [open_nearest, open_share] = walk_clearance(a, 1.45);
+    const auto [tight_nearest, tight_share] = walk_clearance(b, 1.45);
+    EXPECT_GE(tight_nearest, 1.0 - 1e-9) << "seed " << seed << ": boxes' corners count";
+    EXPECT_LT(tight_nearest, 1.35) << "seed " << seed << ": obstacles reach the walk";
+    open_closed += open_share;
+    tight_closed += tight_share;
+    // Beneath the new obstacles, the seed's world as it was: cases pair by seed.
+    EXPECT_EQ(a.person.samples().back().pose.x_m, b.person.samples().back().pose.x_m);
+    ASSERT_EQ(a.pedestrians.size(), b.pedestrians.size());
+    EXPECT_EQ(a.pedestrians[3].position.x_m, b.pedestrians[3].position.x_m);
+    ASSERT_GT(b.world.segments.size() + b.world.circles.size(),
+              a.world.segments.size() + a.world.circles.size());
+    for (size_t i = 0; i < a.world.circles.size(); ++i) {
+      EXPECT_EQ(a.world.circles[i].center.x_m, b.world.circles[i].center.x_m);
+    }
+  }
+  EXPECT_LT(open_closed / 10, 0.02) << "the benchmark's worlds hardly close the points beside";
+  EXPECT_GT(tight_closed / 10, 0.25) << "a constrained world closes them on much of the walk";
 }

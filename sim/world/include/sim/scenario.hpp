@@ -41,6 +41,12 @@ struct RandomScenarioOptions {
   double speed_min_mps = 0.7;
   double speed_max_mps = 1.5;
   double duration_s = 60.0;
+  // > 0: obstacles also beside the walk, every 2-4 m of it, on one side or both (a passage),
+  // their surfaces this far from the person's path (to 0.3 m more): the constrained worlds.
+  // Below ~1.45 m they close the points beside the person (b = 0.7 m, then the costmap's
+  // inflation up to R); near 0.8 m the point behind at corners. They come on top of the
+  // seed's world, which stays as it is (walk, obstacles, pedestrians), so cases pair by seed.
+  double beside_walk_clearance_m = 0;
 };
 Scenario random_scenario(uint32_t seed, const RandomScenarioOptions& options);
 
