@@ -103,7 +103,8 @@ double uniform(std::mt19937& rng, double a, double b) {
 void add_obstacles_beside_walk(Scenario& s, uint32_t seed, double clearance_m) {
   std::mt19937 rng(seed ^ 0x9E3779B9u);
   const std::vector<TimedPose>& walk_samples = s.person.samples();
-  // Exact for both shapes: a box's corners are r sqrt(2) from its centre.
+  // Against a bound of the shape (a box's corners are r sqrt(2) from its centre), so no part of
+  // an obstacle comes nearer the walk than the clearance.
   auto clear = [&](core::Point2 c, double bound_m) {
     for (const TimedPose& tp : walk_samples) {
       if (std::hypot(tp.pose.x_m - c.x_m, tp.pose.y_m - c.y_m) < bound_m + clearance_m) {
@@ -202,7 +203,6 @@ Scenario random_scenario(uint32_t seed, const RandomScenarioOptions& o) {
     }
     return std::hypot(s.robot_start.x_m - c.x_m, s.robot_start.y_m - c.y_m) > r + 1.5;
   };
-
   for (int i = 0, tries = 0; i < o.obstacles && tries < 2000; ++tries) {
     const core::Point2 c{uniform(rng, -13, 13), uniform(rng, -13, 13)};
     const double r = uniform(rng, 0.3, 0.8);
