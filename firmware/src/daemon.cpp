@@ -131,6 +131,17 @@ core::MppiConfig mppi_config(const DaemonConfig& cfg) {
   c.terminal_weight = m.terminal_weight;
   c.collision_cost = m.collision_cost;
   c.cost_threshold = cfg.interactive_space.cost_threshold;
+  c.contact_cost = m.contact_cost;
+  c.guide_samples = m.guide_samples;
+  // The footprint can touch an obstacle closer than its circumscribed radius.
+  const double footprint_x_m =
+      std::max(std::abs(cfg.costmap.footprint_x_min_m), std::abs(cfg.costmap.footprint_x_max_m));
+  const double footprint_y_m =
+      std::max(std::abs(cfg.costmap.footprint_y_min_m), std::abs(cfg.costmap.footprint_y_max_m));
+  c.contact_threshold = core::cost_at_distance(
+      core::CostmapConfig{cfg.costmap.inscribed_radius_m, cfg.costmap.inflation_radius_m,
+                          cfg.costmap.cost_scaling_per_m},
+      std::hypot(footprint_x_m, footprint_y_m));
   c.dcbf_delta = cfg.dcbf.delta;
   c.c_safe = cfg.dcbf.c_safe;
   c.ellipse = core::Ellipse{cfg.interactive_space.ellipse_a_m, cfg.interactive_space.ellipse_b_m};

@@ -34,13 +34,18 @@ Mppi::Mppi(const MppiConfig& config)
       scratch_(mean_.size()),
       update_(mean_.size()),
       pool_(kPoolSize),
-      offset_((static_cast<size_t>(config.samples) + kLanes - 1) / kLanes),
+      offset_((static_cast<size_t>(config.samples) + kLanes - 1) / kLanes +
+              (config.guide_samples ? 1 : 0)),
       cost_(offset_.size() * kLanes),
       tracking_cost_(cost_.size()),
       collision_cost_(cost_.size()),
       barrier_cost_(cost_.size()),
       weight_(cost_.size()),
       rng_state_(config.seed * 0x9E3779B97F4A7C15ULL + 1) {
+  if (config.guide_samples) {
+    guide_block_ = offset_.size() - 1;
+    guide_noise_.resize(mean_.size() * 3 * kLanes);
+  }
   person_frames_.reserve(static_cast<size_t>(config.horizon_steps) + 1);
   goal_frames_.reserve(static_cast<size_t>(config.horizon_steps) + 1);
   active_.reserve(weight_.size());
@@ -81,10 +86,74 @@ void Mppi::shift_mean(Nanos now) {
   mean_.swap(scratch_);
 }
 
-// Noise of sample m (in block m / 8, lane m % 8) at step k, dimension d: the 8 lanes of a block
-// read 8 consecutive floats, so a block's rollout loads whole vectors.
-size_t Mppi::noise_index(size_t m, size_t k, size_t d) const {
-  return (offset_[m / kLanes] + (k * 3 + d) * kLanes + m % kLanes) & (kPoolSize - 1);
+// The 8 lanes of a block read 8 consecutive floats, so a block's rollout loads whole vectors
+// (a pool block starts on a multiple of 8: its row never wraps round the pool's end).
+const float* Mppi::noise_row(size_t block, size_t k, size_t d) const {
+  if (block == guide_block_) return &guide_noise_[(k * 3 + d) * kLanes];
+  return &pool_[(offset_[block] + (k * 3 + d) * kLanes) & (kPoolSize - 1)];
+}
+
+// The structured samples' controls, written as the noise that makes them (n = (u - mean) /
+// sigma): lane 0 the mean, lane 1 a full brake, lanes 2 and 3 the steering law at full and half
+// speed, lanes 4-7 random (the pool's, as any other block).
+void Mppi::prepare_guide_block(const MppiInputs& in) {
+  constexpr size_t kL = kLanes;
+  const size_t horizon = mean_.size();
+  const double dt = cfg_.step_s;
+  const double dv = cfg_.linear_accel_mps2 * dt;
+  const double dw = cfg_.angular_accel_radps2 * dt;
+  const TwistLimits& lim = cfg_.limits;
+  auto put = [&](size_t lane, size_t k, const Twist& u) {
+    const Twist& mu = mean_[k];
+    guide_noise_[(k * 3 + 0) * kL + lane] = static_cast<float>((u.vx - mu.vx) / cfg_.sigma[0]);
+    guide_noise_[(k * 3 + 1) * kL + lane] = static_cast<float>((u.vy - mu.vy) / cfg_.sigma[1]);
+    guide_noise_[(k * 3 + 2) * kL + lane] = static_cast<float>((u.wz - mu.wz) / cfg_.sigma[2]);
+  };
+  auto toward = [](double from, double to, double step) {
+    return std::clamp(to, from - step, from + step);
+  };
+  // The steering law: the world velocity of q^d's path plus a pull of 1/s toward it, at most
+  // `speed` of the box (scaled as a vector, so the direction holds), the heading error closed at
+  // 2/s; every step within the base's accelerations, as the rollouts will clamp it.
+  auto steer = [&](size_t lane, double speed) {
+    Pose2 p = in.robot;
+    Twist prev = in.current;
+    const TwistLimits box{lim.vx * speed, lim.vy * speed, lim.wz};
+    for (size_t k = 0; k < horizon; ++k) {
+      const GoalFrame& g0 = goal_frames_[std::min(k, goal_frames_.size() - 1)];
+      const GoalFrame& g1 = goal_frames_[std::min(k + 1, goal_frames_.size() - 1)];
+      const double wx = (g1.x - g0.x) / dt + (g1.x - p.x_m);
+      const double wy = (g1.y - g0.y) / dt + (g1.y - p.y_m);
+      const double c = std::cos(p.theta_rad);
+      const double s = std::sin(p.theta_rad);
+      double bx = c * wx + s * wy;
+      double by = -s * wx + c * wy;
+      const double scale = std::min(
+          {1.0, box.vx / std::max(std::abs(bx), 1e-9), box.vy / std::max(std::abs(by), 1e-9)});
+      bx *= scale;
+      by *= scale;
+      const double bw = std::clamp(2.0 * wrap_angle(g1.theta - p.theta_rad), -box.wz, box.wz);
+      const Twist u{toward(prev.vx, bx, dv), toward(prev.vy, by, dv), toward(prev.wz, bw, dw)};
+      put(lane, k, u);
+      p = Pose2{p.x_m + (u.vx * c - u.vy * s) * dt, p.y_m + (u.vx * s + u.vy * c) * dt,
+                p.theta_rad + u.wz * dt};
+      prev = u;
+    }
+  };
+  Twist brake = in.current;
+  for (size_t k = 0; k < horizon; ++k) {
+    put(0, k, mean_[k]);
+    brake = Twist{toward(brake.vx, 0.0, dv), toward(brake.vy, 0.0, dv), toward(brake.wz, 0.0, dw)};
+    put(1, k, brake);
+    for (size_t lane = 4; lane < kL; ++lane) {
+      for (size_t d = 0; d < 3; ++d) {
+        guide_noise_[(k * 3 + d) * kL + lane] =
+            pool_[(offset_[guide_block_] + (k * 3 + d) * kL + lane) & (kPoolSize - 1)];
+      }
+    }
+  }
+  steer(2, 1.0);
+  steer(3, 0.5);
 }
 
 void Mppi::rollout_block(size_t block, const MppiInputs& in) {
@@ -117,6 +186,8 @@ void Mppi::rollout_block(size_t block, const MppiInputs& in) {
   const bool with_person = !person_frames_.empty();
   const bool with_map = in.costmap != nullptr;
   const auto collision = static_cast<float>(cfg_.collision_cost);
+  const bool with_contact = cfg_.contact_cost > 0.0;
+  const auto contact = static_cast<float>(cfg_.contact_cost);
 
   // Tracking: the error in the frame of the goal at step k (or of the robot at the start), the
   // angle wrapped to (-pi, pi].
@@ -170,15 +241,14 @@ void Mppi::rollout_block(size_t block, const MppiInputs& in) {
     }
   };
   if (with_person) barrier_lanes(0, h);
-  const size_t base = offset_[block];
   alignas(32) float hn[kL];
   for (size_t k = 0; k < horizon; ++k) {
     const auto mvx = static_cast<float>(mean_[k].vx);
     const auto mvy = static_cast<float>(mean_[k].vy);
     const auto mwz = static_cast<float>(mean_[k].wz);
-    const float* n0 = &pool_[(base + (k * 3 + 0) * kL) & (kPoolSize - 1)];
-    const float* n1 = &pool_[(base + (k * 3 + 1) * kL) & (kPoolSize - 1)];
-    const float* n2 = &pool_[(base + (k * 3 + 2) * kL) & (kPoolSize - 1)];
+    const float* n0 = noise_row(block, k, 0);
+    const float* n1 = noise_row(block, k, 1);
+    const float* n2 = noise_row(block, k, 2);
     goal_at(k + 1);  // the control of step k leads to the state of step k + 1
     for (size_t j = 0; j < kL; ++j) {
       // The sampled control, in the velocity box and reachable from the previous one with the
@@ -211,8 +281,12 @@ void Mppi::rollout_block(size_t block, const MppiInputs& in) {
     if (with_map) {
       for (size_t j = 0; j < kL; ++j) {
         if (in.costmap->cost_at_least(x[j], y[j], cfg_.cost_threshold)) {
-          cost[j] += collision;
-          col[j] += collision;
+          const float c_step =
+              with_contact && in.costmap->cost_at_least(x[j], y[j], cfg_.contact_threshold)
+                  ? contact
+                  : collision;
+          cost[j] += c_step;
+          col[j] += c_step;
         }
       }
     }
@@ -265,6 +339,7 @@ MppiOutput Mppi::step(const MppiInputs& in) {
     // A block's noise is contiguous per (step, dimension): aligned to whole vectors.
     o = static_cast<uint32_t>(next_random(rng_state_) % kPoolSize) & ~uint32_t{kLanes - 1};
   }
+  if (guide_block_ != SIZE_MAX) prepare_guide_block(in);
   const auto blocks = static_cast<int64_t>(offset_.size());
 #pragma omp parallel for num_threads(cfg_.threads) schedule(static)
   for (int64_t b = 0; b < blocks; ++b)
@@ -337,11 +412,13 @@ MppiOutput Mppi::step(const MppiInputs& in) {
   std::fill(update_.begin(), update_.end(), Twist{});
   for (const uint32_t m : active_) {
     const double w = weight_[m];
+    const size_t block = m / kLanes;
+    const size_t lane = m % kLanes;
     for (size_t k = 0; k < mean_.size(); ++k) {
       Twist& d = update_[k];
-      d.vx += w * static_cast<double>(pool_[noise_index(m, k, 0)]);
-      d.vy += w * static_cast<double>(pool_[noise_index(m, k, 1)]);
-      d.wz += w * static_cast<double>(pool_[noise_index(m, k, 2)]);
+      d.vx += w * static_cast<double>(noise_row(block, k, 0)[lane]);
+      d.vy += w * static_cast<double>(noise_row(block, k, 1)[lane]);
+      d.wz += w * static_cast<double>(noise_row(block, k, 2)[lane]);
     }
   }
   for (size_t k = 0; k < mean_.size(); ++k) {

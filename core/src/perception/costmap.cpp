@@ -98,11 +98,9 @@ void Costmap::build(const VoxelGrid& grid, const CostmapConfig& config, Nanos st
     lut_.resize(max_d2 + 1);
     for (size_t d2 = 0; d2 <= max_d2; ++d2) {
       const double d = std::sqrt(static_cast<double>(d2)) * res_;
-      lut_[d2] =
-          d <= config.inscribed_radius_m
-              ? kCostLethal
-              : static_cast<uint8_t>(std::lround(
-                    99.0 * std::exp(-config.cost_scaling_per_m * (d - config.inscribed_radius_m))));
+      lut_[d2] = d <= config.inscribed_radius_m
+                     ? kCostLethal
+                     : static_cast<uint8_t>(std::lround(cost_at_distance(config, d)));
     }
     lut_config_ = config;
     lut_res_ = res_;

@@ -774,6 +774,27 @@ std::vector<FieldSpec> build() {
        0.0,
        1e9,
        {}},
+      {"mppi.contact_cost",
+       "-",
+       "Cost of a predicted state where the footprint can touch an obstacle (costmap cost at or "
+       "above the cost at the footprint's circumscribed radius), instead of c_collision (not in "
+       "the paper; 0: off, the paper's single tier). Must outweigh what lagging behind q^d costs "
+       "over the horizon, or the best plan may cut through an obstacle to catch up.",
+       FIELD(mppi.contact_cost),
+       0.0,
+       1e9,
+       {}},
+      {"mppi.guide_samples",
+       "bool",
+       "Eight structured samples beside the random ones (not in the paper): the previous plan, a "
+       "full brake, and a law that steers straight to q^d's path at full and half speed. "
+       "Weighed by their cost like the rest, they let the controller brake and turn when the "
+       "person turns sharply while the robot is fast (random noise about the last plan does not "
+       "reach that far, and the robot swings wide). false: the paper's M random samples.",
+       FIELD(mppi.guide_samples),
+       0,
+       0,
+       {}},
       {"mppi.noise_vx_mps",
        "m/s",
        "Sigma: std-dev of the sampled forward-velocity noise (> 0: the control cost divides by "

@@ -143,6 +143,33 @@ TEST(Mppi, GoesAroundAWallBetweenRobotAndGoal) {
   EXPECT_LT(std::hypot(loop.robot.x_m - goal.x_m, loop.robot.y_m - goal.y_m), 0.2);
 }
 
+// The contact tier: with c_collision alone, a controller that weighs the tracking error heavily
+// (a robot far behind a person who walks on) finds cutting through a wall cheaper than going
+// round it, and drives its centre where the footprint touches. contact_cost makes those steps
+// dearer than any lag, and the robot goes round.
+TEST(Mppi, TheContactTierKeepsAHeavilyTrackingRobotOutOfTheWall) {
+  const core::Costmap map = wall_map();
+  // The highest costmap cost the robot's centre passes over on its way to the goal.
+  auto highest_cost_passed = [&](double contact_cost) {
+    auto cfg = test_config();
+    cfg.horizon_steps = 40;
+    cfg.q = {2000.0, 2000.0, 0.0};
+    cfg.contact_cost = contact_cost;
+    cfg.contact_threshold = 71.0;  // about the cost at the default footprint's corner radius
+    Loop loop(cfg);
+    double highest = 0;
+    for (int i = 0; i < 600; ++i) {
+      EXPECT_TRUE(loop.tick(Pose2{3.0, 0.0, 0.0}, {}, &map).ok);
+      highest = std::max(highest, map.cost(loop.robot.x_m, loop.robot.y_m));
+    }
+    EXPECT_LT(std::hypot(loop.robot.x_m - 3.0, loop.robot.y_m), 0.3) << contact_cost;
+    return highest;
+  };
+  EXPECT_GT(highest_cost_passed(0.0), 99.0) << "the single tier cuts through the lethal core";
+  // Round it, grazing the threshold between two 0.1 s steps at most.
+  EXPECT_LT(highest_cost_passed(1e5), 80.0) << "the contact tier goes round the wall";
+}
+
 // The best rollout's cost by term (published in the status and the evaluation's samples, to say
 // why the robot left q^d): each term where its cause is, and the terms sum to the total.
 TEST(Mppi, TheBestPlansCostIsSplitIntoItsTermsWhereTheirCausesAre) {

@@ -235,6 +235,22 @@ TEST(Config, ControllerParametersComeFromTheConfigurationAsInThePaper) {
   EXPECT_DOUBLE_EQ(w.b_m, core_defaults.b_m);
 }
 
+// The contact tier: its cost from the file, its threshold the costmap's cost at the footprint's
+// circumscribed radius (0.35 x 0.30 m half-extents: 0.461 m, cost 99 exp(-3 (0.461 - 0.35))).
+TEST(Config, TheContactTierIsWhereTheFootprintCanTouch) {
+  const auto c = firmware::mppi_config(*firmware::load_default_config().config);
+  EXPECT_DOUBLE_EQ(c.contact_cost, 100000.0);
+  EXPECT_NEAR(c.contact_threshold, 99.0 * std::exp(-3.0 * (std::hypot(0.35, 0.30) - 0.35)), 1e-9);
+  EXPECT_GT(c.contact_threshold, c.cost_threshold);
+  const auto wide = load_config_text(
+      "costmap:\n  footprint_y_min_m: -0.45\n  footprint_y_max_m: 0.45\nmppi:\n  contact_cost: 0\n",
+      "test.yaml");
+  ASSERT_TRUE(wide.ok()) << wide.errors[0].to_string();
+  const auto w = firmware::mppi_config(*wide.config);
+  EXPECT_DOUBLE_EQ(w.contact_cost, 0.0);
+  EXPECT_LT(w.contact_threshold, c.contact_threshold) << "a wider robot touches from farther";
+}
+
 TEST(Config, TheTrackingFrameIsAChoiceThatReachesTheController) {
   expect_error(load_config_text("mppi:\n  tracking_frame: odom\n", "test.yaml"), 2,
                "mppi.tracking_frame", "not one of");

@@ -5,11 +5,12 @@
 //   per step k: tracking (q_k - q^d_k)^T Q (q_k - q^d_k), the error expressed in the goal's frame
 //   (e_x along the goal heading, e_y across it) or the robot's at the start (TrackingFrame),
 //   e_theta wrapped; c_collision when the costmap
-//   cost (bilinear) >= R; c_safe max((1 - delta) h_k - h_{k+1}, 0) with h the ellipse barrier
-//   around the person's PREDICTED pose at step k; the control cost lambda u^T Sigma^-1 eps;
-//   a terminal tracking cost at K. Sampled controls are limited to the velocity box and to what
-//   the base's accelerations reach from the previous control.
-//   weights w_m = exp(-(S_m - min S) / lambda); the mean sequence moves by the weighted noise.
+//   cost (bilinear) >= R (c_contact instead where the footprint can touch); c_safe max((1 - delta)
+//   h_k - h_{k+1}, 0) with h the ellipse barrier around the person's PREDICTED pose at step k; the
+//   control cost lambda u^T Sigma^-1 eps; a terminal tracking cost at K. Sampled controls are
+//   limited to the velocity box and to what the base's accelerations reach from the previous
+//   control. weights w_m = exp(-(S_m - min S) / lambda); the mean sequence moves by the weighted
+//   noise.
 // Warm start: the previous mean shifted by the elapsed time (fractionally: the controller runs
 // every 10 ms while a step is 100 ms), optional smoothing. Noise comes from a pre-generated
 // pool of standard normals (offsets drawn per sample), so it is cheap and reproducible.
@@ -46,6 +47,13 @@ struct MppiConfig {
   double terminal_weight = 2.0;  // the terminal cost is this times Q's
   double collision_cost = 1000.0;
   double cost_threshold = 30.0;  // R
+  // A second tier, not in the paper: a predicted state whose costmap cost is >= contact_threshold
+  // (where the footprint can touch an obstacle: the cost at its circumscribed radius) costs
+  // contact_cost instead of collision_cost. With c_collision alone, crossing a few steps of the
+  // unsafe band costs less than lagging a metre behind q^d over the horizon, and the best plan
+  // can run the robot into the obstacle itself. 0: off (the paper's single tier).
+  double contact_cost = 0.0;
+  double contact_threshold = 100.0;
   double dcbf_delta = 0.5;
   double c_safe = 5000.0;
   Ellipse ellipse;
@@ -56,6 +64,13 @@ struct MppiConfig {
   double linear_accel_mps2 = 1.5;  // applied to the output command
   double angular_accel_radps2 = 3.0;
   bool smooth = true;  // 3-tap smoothing of the updated mean sequence
+  // Eight structured samples beside the M random ones (not in the paper): the mean itself, a
+  // full brake, and a feedback law that steers to q^d's path at full and at half speed (the
+  // rest random). Random noise about a warm-started mean explores a few tenths of a m/s: when
+  // the person turns sharply while the robot is fast, no random sample brakes and turns in
+  // time, and the update keeps the robot on a wide loop away from them. The structured samples
+  // are weighed like the others (by their cost), so they only win where they are better.
+  bool guide_samples = false;
   int threads = 2;
   uint64_t seed = 1;
 };
@@ -77,7 +92,7 @@ struct MppiInputs {
 // a barrier term, that it enters the person's ellipse faster than the DCBF allows.
 struct MppiCostTerms {
   double tracking = 0;   // stage + terminal tracking of q^d
-  double collision = 0;  // collision_cost per step at costmap cost >= R
+  double collision = 0;  // collision_cost per step at costmap cost >= R (contact_cost in contact)
   double barrier = 0;    // c_safe max((1 - delta) h_k - h_{k+1}, 0)
   double control = 0;    // lambda u^T Sigma^-1 eps (may be negative)
 };
@@ -109,7 +124,10 @@ class Mppi {
   static constexpr size_t kLanes = 8;  // samples per vectorised block (M is rounded up)
   void shift_mean(Nanos now);
   void rollout_block(size_t block, const MppiInputs& in);
-  [[nodiscard]] size_t noise_index(size_t m, size_t k, size_t d) const;
+  void prepare_guide_block(const MppiInputs& in);
+  // The kLanes noise values of a block at step k, dimension d (standard normals: u = mean +
+  // sigma n).
+  [[nodiscard]] const float* noise_row(size_t block, size_t k, size_t d) const;
 
   MppiConfig cfg_;
   std::vector<Twist> mean_;       // K controls
@@ -117,7 +135,11 @@ class Mppi {
   std::vector<Twist> update_;     // K: the weighted noise the mean moves by
   std::vector<float> pool_;       // standard normals
   std::vector<uint32_t> offset_;  // per block of kLanes samples: where its noise starts
-  std::vector<double> cost_;      // per sample
+  // The structured samples' block (the last one; none when guide_samples is off) and its noise,
+  // laid out as a pool block: (k * 3 + d) * kLanes + lane.
+  size_t guide_block_ = SIZE_MAX;
+  std::vector<float> guide_noise_;
+  std::vector<double> cost_;                                          // per sample
   std::vector<float> tracking_cost_, collision_cost_, barrier_cost_;  // per sample, by term
   std::vector<double> weight_;                                        // per sample
   std::vector<uint32_t> active_;  // samples that carry weight (capacity M: no allocation)

@@ -6,6 +6,7 @@
 //   0    free, or farther than the inflation radius from every obstacle.
 // With r_inscribed = 0.35 m and k = 3 /m, cost >= 30 (R, "unsafe") means d < 0.75 m.
 // A Costmap is a plain value: built by the lidar task, then published as an immutable snapshot.
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -20,6 +21,14 @@ struct CostmapConfig {
 };
 
 inline constexpr uint8_t kCostLethal = 100;
+
+// The cost of a cell at distance d_m from the nearest obstacle (before rounding to a cell value):
+// the scale above. The controller uses it to find the cost at which its footprint can touch.
+inline double cost_at_distance(const CostmapConfig& config, double d_m) {
+  if (d_m <= config.inscribed_radius_m) return kCostLethal;
+  if (d_m > config.inflation_radius_m) return 0.0;
+  return 99.0 * std::exp(-config.cost_scaling_per_m * (d_m - config.inscribed_radius_m));
+}
 
 class Costmap {
  public:

@@ -138,6 +138,8 @@ struct DaemonConfig {
     double q_theta = 0;
     std::string tracking_frame;  // goal, robot
     double collision_cost = 0;
+    double contact_cost = 0;  // 0: off
+    bool guide_samples = false;
     double noise_vx_mps = 0;
     double noise_vy_mps = 0;
     double noise_wz_radps = 0;
