@@ -607,6 +607,7 @@ bool Daemon::run_controller(Nanos now, core::BodyVelocity& requested) {
   control_state_.repaired = out.repaired;
   if (out.repaired) ++control_state_.repairs;
   if (out.closing_limited) ++control_state_.closing_limits;
+  if (out.guided) ++control_state_.guided_plans;
   control_state_.min_cost = out.min_cost;
   control_state_.best_cost = out.best;
   control_state_.effective_samples = out.effective_samples;

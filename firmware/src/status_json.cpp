@@ -95,6 +95,7 @@ std::string Daemon::build_status_json(core::Nanos now) const {
                     {"failures", v.failures},
                     {"repairs", v.repairs},
                     {"closing_limits", v.closing_limits},
+                    {"guided_plans", v.guided_plans},
                     {"effective_samples", number(v.effective_samples)},
                     {"min_cost", number(v.min_cost)},
                     {"best_cost",

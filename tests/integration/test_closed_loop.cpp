@@ -383,7 +383,7 @@ TEST(ClosedLoop, GuideSamplesBrakeAndTurnWhereRandomSamplesSwingWide) {
   // person's new heading): 4 m out by 14.5 s, into the obstacles beside the corner, lost. The
   // structured samples (mppi.guide_samples: a brake, a law that steers to q^d's path) find the
   // brake-and-turn.
-  auto run = [](bool guide_samples) {
+  auto run = [](bool guide_samples, uint64_t& guided_plans) {
     SimRunOptions o;
     o.config = defaults();
     sim::RandomScenarioOptions clutter;
@@ -392,10 +392,19 @@ TEST(ClosedLoop, GuideSamplesBrakeAndTurnWhereRandomSamplesSwingWide) {
     o.seed = 6;
     o.duration_s = 16.0;
     o.config.mppi.guide_samples = guide_samples;
+    o.script = [&](double, sim::SimWorld&, firmware::Daemon& d) {
+      if (const auto c = d.control_status().read()) guided_plans = c->value.guided_plans;
+    };
     return sim::run_simulation(o);
   };
-  const auto random_only = run(false);
-  const auto guided = run(true);
+  uint64_t guided_plans_off = 0;
+  uint64_t guided_plans_on = 0;
+  const auto random_only = run(false, guided_plans_off);
+  const auto guided = run(true, guided_plans_on);
+  std::printf("plans a structured sample made: %llu of ~1500 control steps\n",
+              static_cast<unsigned long long>(guided_plans_on));
+  EXPECT_EQ(guided_plans_off, 0U);
+  EXPECT_GT(guided_plans_on, 0U) << "counted in the status (control.guided_plans)";
   print("random samples only", random_only);
   print("with guide samples", guided);
   ASSERT_GT(random_only.metrics.max_person_distance_m, 3.0)

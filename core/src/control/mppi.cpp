@@ -242,6 +242,14 @@ void Mppi::rollout_block(size_t block, const MppiInputs& in) {
   };
   if (with_person) barrier_lanes(0, h);
   alignas(32) float hn[kL];
+  // The control cost's weight per lane: 0 for the structured samples (lanes 0-3 of the guide
+  // block). lambda mu^T Sigma^-1 eps is the importance-sampling term of a random draw about the
+  // mean; for a sample placed far from the mean on purpose it is no cost but an artefact of the
+  // distance (the brake from 1.7 m/s earns about -3000 over the horizon) that would let it win
+  // where it is worse.
+  alignas(32) float control_weight[kL];
+  for (size_t j = 0; j < kL; ++j)
+    control_weight[j] = block == guide_block_ && j < 4 ? 0.0f : 1.0f;
   for (size_t k = 0; k < horizon; ++k) {
     const auto mvx = static_cast<float>(mean_[k].vx);
     const auto mvy = static_cast<float>(mean_[k].vy);
@@ -263,7 +271,7 @@ void Mppi::rollout_block(size_t block, const MppiInputs& in) {
       pvy[j] = vy;
       pwz[j] = wz;
       // lambda u^T Sigma^-1 eps, eps = sigma n: lambda sum(mu_d n_d / sigma_d)
-      cost[j] += lam * (mvx * n0[j] / s0 + mvy * n1[j] / s1 + mwz * n2[j] / s2);
+      cost[j] += control_weight[j] * lam * (mvx * n0[j] / s0 + mvy * n1[j] / s1 + mwz * n2[j] / s2);
       x[j] += (vx * c[j] - vy * s[j]) * dt;
       y[j] += (vx * s[j] + vy * c[j]) * dt;
       const float a = wz * dt;
@@ -344,10 +352,22 @@ MppiOutput Mppi::step(const MppiInputs& in) {
 #pragma omp parallel for num_threads(cfg_.threads) schedule(static)
   for (int64_t b = 0; b < blocks; ++b)
     rollout_block(static_cast<size_t>(b), in);
+  // The structured samples (lanes 0-3 of the guide block) do not enter the weighted average:
+  // they lie far from the mean on purpose, and any weight they had would pull it toward them
+  // step after step (the brake toward a standstill) whether or not they were better. One of them
+  // replaces the plan instead, when it beats every random sample.
+  auto structured = [&](size_t m) { return m / kLanes == guide_block_ && m % kLanes < 4; };
   double min_cost = std::numeric_limits<double>::infinity();
   size_t best = 0;
+  double guide_cost = std::numeric_limits<double>::infinity();
+  size_t guide = 0;
   for (size_t m = 0; m < cost_.size(); ++m) {
-    if (cost_[m] < min_cost) {
+    if (structured(m)) {
+      if (m % kLanes != 0 && cost_[m] < guide_cost) {  // lane 0, the mean itself, is no change
+        guide_cost = cost_[m];
+        guide = m;
+      }
+    } else if (cost_[m] < min_cost) {
       min_cost = cost_[m];
       best = m;
     }
@@ -356,16 +376,21 @@ MppiOutput Mppi::step(const MppiInputs& in) {
     reset();
     return out;  // ok = false, zero command
   }
+  const bool take_guide = guide_cost < min_cost;
+  out.guided = take_guide;
+  if (take_guide) best = guide;
   out.best.tracking = static_cast<double>(tracking_cost_[best]);
   out.best.collision = static_cast<double>(collision_cost_[best]);
   out.best.barrier = static_cast<double>(barrier_cost_[best]);
-  out.best.control = min_cost - out.best.tracking - out.best.collision - out.best.barrier;
+  out.best.control = cost_[best] - out.best.tracking - out.best.collision - out.best.barrier;
   // Importance weights at temperature lambda; raised (geometrically, then bisected in log space)
   // when fewer than min_effective_samples samples would carry the update.
   auto weigh = [&](double lambda) {
     double total = 0.0;
     for (size_t m = 0; m < cost_.size(); ++m) {
-      weight_[m] = std::isfinite(cost_[m]) ? std::exp(-(cost_[m] - min_cost) / lambda) : 0.0;
+      weight_[m] = std::isfinite(cost_[m]) && !structured(m)
+                       ? std::exp(-(cost_[m] - min_cost) / lambda)
+                       : 0.0;
       total += weight_[m];
     }
     double sum_sq = 0.0;
@@ -410,8 +435,9 @@ MppiOutput Mppi::step(const MppiInputs& in) {
   // Sample by sample (each sample's noise lies in one small stretch of the pool, so it is read
   // from cache; step by step it was a cache miss per sample), the sums still in ascending m.
   std::fill(update_.begin(), update_.end(), Twist{});
+  if (take_guide) active_.assign(1, static_cast<uint32_t>(guide));  // the whole way, weight 1
   for (const uint32_t m : active_) {
-    const double w = weight_[m];
+    const double w = take_guide ? 1.0 : weight_[m];
     const size_t block = m / kLanes;
     const size_t lane = m % kLanes;
     for (size_t k = 0; k < mean_.size(); ++k) {
@@ -438,7 +464,7 @@ MppiOutput Mppi::step(const MppiInputs& in) {
     }
   }
   out.nominal = mean_.front();
-  out.min_cost = min_cost;
+  out.min_cost = cost_[best];
   out.effective_samples = ess;
   out.lambda = lambda;
   Twist u = out.nominal;

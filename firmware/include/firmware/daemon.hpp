@@ -115,6 +115,7 @@ struct ControlStatus {
   uint64_t failures = 0;        // MPPI steps that failed
   uint64_t repairs = 0;         // first controls the QP repair changed
   uint64_t closing_limits = 0;  // commands slowed toward the person (closing_speed.*)
+  uint64_t guided_plans = 0;    // steps where a structured sample became the plan (guide_samples)
   core::BodyVelocity command;   // after the supervisor's gate (what went to the base)
 };
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <random>
 
@@ -168,6 +169,53 @@ TEST(Mppi, TheContactTierKeepsAHeavilyTrackingRobotOutOfTheWall) {
   EXPECT_GT(highest_cost_passed(0.0), 99.0) << "the single tier cuts through the lethal core";
   // Round it, grazing the threshold between two 0.1 s steps at most.
   EXPECT_LT(highest_cost_passed(1e5), 80.0) << "the contact tier goes round the wall";
+}
+
+// A robot running at full speed at a wall, its plan warm-started on running on. A structured
+// sample (the full brake, or the law steering to the goal in front of the wall) beats every
+// random one at some step and becomes the plan (MppiOutput::guided); the robot stops short of
+// where its footprint touches. (Random samples alone also stop here, straight at a wall on
+// the expensive axis; where they do not, the person's turn across a fast robot, is
+// ClosedLoop.GuideSamplesBrakeAndTurnWhereRandomSamplesSwingWide.) Without guide samples no
+// plan is ever a structured one.
+TEST(Mppi, AStructuredSampleBecomesThePlanWhereItBeatsEveryRandomOne) {
+  const core::Costmap map = wall_map();  // lethal core at x = 1.5 m
+  auto run = [&](bool guide_samples, bool& guided) {
+    auto cfg = test_config();
+    cfg.guide_samples = guide_samples;
+    cfg.contact_cost = 1e5;
+    cfg.contact_threshold = 71.0;
+    cfg.horizon_steps = 100;  // the daemon's: 10 s horizon, the update shared by >= 50 samples
+    cfg.samples = 2000;
+    cfg.min_effective_samples = 50;
+    Loop loop(cfg);
+    // Warm start: 1 s running along x at the limit toward a goal far ahead, on an open floor.
+    loop.last = Twist{1.8, 0.0, 0.0};
+    for (int i = 0; i < 100; ++i)
+      loop.tick(Pose2{30.0, 0.0, 0.0}, {}, nullptr);
+    // Now the wall is seen, the goal in front of it: 1.24 m from the robot to where its
+    // footprint touches, 1.08 m of it a full brake from 1.8 m/s at 1.5 m/s^2.
+    loop.robot = Pose2{-0.2, 0.0, 0.0};
+    guided = false;
+    double highest = 0;
+    for (int i = 0; i < 300; ++i) {
+      const auto out = loop.tick(Pose2{0.5, 0.0, 0.0}, {}, &map);
+      EXPECT_TRUE(out.ok);
+      guided = guided || out.guided;
+      highest = std::max(highest, map.cost(loop.robot.x_m, loop.robot.y_m));
+    }
+    return highest;
+  };
+  bool guided_off = false;
+  bool guided_on = false;
+  const double random_only = run(false, guided_off);
+  const double structured = run(true, guided_on);
+  std::printf("highest cost passed: random only %.1f, with structured samples %.1f\n", random_only,
+              structured);
+  EXPECT_FALSE(guided_off);
+  EXPECT_TRUE(guided_on) << "a structured sample became the plan";
+  EXPECT_LT(structured, 71.0) << "stopped short of where the footprint touches";
+  EXPECT_LT(random_only, 71.0);
 }
 
 // The best rollout's cost by term (published in the status and the evaluation's samples, to say

@@ -69,7 +69,8 @@ struct MppiConfig {
   // rest random). Random noise about a warm-started mean explores a few tenths of a m/s: when
   // the person turns sharply while the robot is fast, no random sample brakes and turns in
   // time, and the update keeps the robot on a wide loop away from them. The structured samples
-  // are weighed like the others (by their cost), so they only win where they are better.
+  // are not averaged in (any weight would pull the plan toward them, better or not): the best
+  // of them becomes the plan when it costs less than every random sample.
   bool guide_samples = false;
   int threads = 2;
   uint64_t seed = 1;
@@ -104,6 +105,7 @@ struct MppiOutput {
   bool repaired = false;
   bool repair_feasible = true;
   bool closing_limited = false;  // slowed toward the person (ClosingSpeedConfig)
+  bool guided = false;           // a structured sample beat every random one and became the plan
   double min_cost = 0;           // best sample's cost
   MppiCostTerms best;            // ... by term
   double effective_samples = 0;  // 1 / sum(w^2): how many samples carried the update
