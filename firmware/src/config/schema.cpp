@@ -787,10 +787,12 @@ std::vector<FieldSpec> build() {
       {"mppi.guide_samples",
        "bool",
        "Eight structured samples beside the random ones (not in the paper): the previous plan, a "
-       "full brake, and a law that steers straight to q^d's path at full and half speed. "
-       "Weighed by their cost like the rest, they let the controller brake and turn when the "
+       "full brake, and a law that steers straight to q^d's path at full and half speed, scored "
+       "by the same cost. They are not averaged in; the best of them becomes the plan when it "
+       "costs less than every random sample, so the controller can brake and turn when the "
        "person turns sharply while the robot is fast (random noise about the last plan does not "
-       "reach that far, and the robot swings wide). false: the paper's M random samples.",
+       "reach that far, and the robot swings wide). Counted in control.guided_plans. false: "
+       "the paper's M random samples.",
        FIELD(mppi.guide_samples),
        0,
        0,
