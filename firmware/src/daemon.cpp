@@ -86,6 +86,7 @@ core::HumanEkfConfig human_ekf_config(const DaemonConfig& cfg) {
   c.accel_noise_mps2 = h.accel_noise_mps2;
   c.yaw_accel_noise_radps2 = h.yaw_accel_noise_radps2;
   c.prediction_time_constant_s = h.prediction_time_constant_s;
+  c.prediction_turn_time_constant_s = h.prediction_turn_time_constant_s;
   c.gate_probability = h.gate_probability;
   c.reset_after_rejects = static_cast<uint32_t>(h.reset_after_rejects);
   c.reset_after_gap = core::from_ms(h.reset_after_gap_ms);
@@ -569,10 +570,14 @@ bool Daemon::run_controller(Nanos now, core::BodyVelocity& requested) {
   // may be. q^d, the point to be at, walks with them on a velocity that fades with
   // human.prediction_time_constant_s (2 s by default), so it stays on the costmap; at constant
   // velocity (0) it runs ~15 m ahead over the 10 s horizon, off the map (docs/EVALUATION.md).
-  core::predict_path(track->value, now, mppi_.config().step_s, 0.0, person_path_);
+  // The turn rate fades with human.prediction_turn_time_constant_s when set (0: as the velocity).
+  const double turn_s = human_config_.prediction_turn_time_constant_s;
+  core::predict_path(track->value, now, mppi_.config().step_s, 0.0, turn_s, person_path_);
   if (human_config_.prediction_time_constant_s > 0.0) {
     core::predict_path(track->value, now, mppi_.config().step_s,
-                       human_config_.prediction_time_constant_s, goal_path_);
+                       human_config_.prediction_time_constant_s,
+                       turn_s > 0.0 ? turn_s : human_config_.prediction_time_constant_s,
+                       goal_path_);
   } else {
     std::copy(person_path_.begin(), person_path_.end(), goal_path_.begin());
   }

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <memory>
 #include <random>
 #include <vector>
@@ -54,14 +55,23 @@ struct Warm {
 
 // `min_ess`: the shipped configuration floors the effective sample size at 50 (a temperature
 // search per step); 0 is the paper's fixed lambda = 1, the baseline in the same run.
-Warm& warm(int threads, int min_ess) {
-  static std::array<std::unique_ptr<Warm>, 6> cache;
-  auto& w = cache[static_cast<size_t>(threads * 2 + (min_ess > 0 ? 1 : 0))];
+// `guide`: 1 adds what the shipped configuration adds beyond the paper (mppi.guide_samples: one
+// block of 8 structured rollouts and two steering-law integrations per step; mppi.contact_cost:
+// a second tier where the Scout Mini's 0.70 x 0.60 m footprint can touch, as the daemon sets it);
+// 0 is the paper's M random samples and single collision tier, the baseline in the same run.
+Warm& warm(int threads, int min_ess, int guide) {
+  static std::array<std::unique_ptr<Warm>, 12> cache;
+  auto& w = cache[static_cast<size_t>(threads * 4 + (min_ess > 0 ? 2 : 0) + (guide > 0 ? 1 : 0))];
   if (!w) {
     w = std::make_unique<Warm>();
     core::MppiConfig cfg;  // K = 100, M = 2000
     cfg.threads = threads;
     cfg.min_effective_samples = min_ess;
+    if (guide > 0) {
+      cfg.guide_samples = true;
+      cfg.contact_cost = 100000.0;
+      cfg.contact_threshold = core::cost_at_distance(core::CostmapConfig{}, std::hypot(0.35, 0.30));
+    }
     w->mppi = std::make_unique<core::Mppi>(cfg);
     w->map = scene();
     for (int k = 0; k <= 100; ++k)
@@ -79,7 +89,8 @@ Warm& warm(int threads, int min_ess) {
 }
 
 void BM_MppiStep(benchmark::State& state) {
-  Warm& w = warm(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  Warm& w = warm(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)),
+                 static_cast<int>(state.range(2)));
   for (auto _ : state) {
     w.in.now = w.t;
     const auto out = w.mppi->step(w.in);
@@ -89,11 +100,13 @@ void BM_MppiStep(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_MppiStep)
-    ->ArgNames({"threads", "min_ess"})
-    ->Args({1, 0})
-    ->Args({1, 50})
-    ->Args({2, 0})
-    ->Args({2, 50})
+    ->ArgNames({"threads", "min_ess", "guide"})
+    ->Args({1, 0, 0})
+    ->Args({1, 50, 0})
+    ->Args({1, 50, 1})
+    ->Args({2, 0, 0})
+    ->Args({2, 50, 0})
+    ->Args({2, 50, 1})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(1)
     ->Repetitions(100)

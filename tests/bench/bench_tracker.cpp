@@ -106,7 +106,7 @@ void BM_HumanStateAndPath(benchmark::State& state) {
   const core::HumanEkfConfig cfg;
   for (auto _ : state) {
     const auto h = core::human_state(ekf.track(), 2s, core::Pose2{0.5, 0.1, 0.2}, cfg);
-    core::predict_path(ekf.track(), 2s, 0.1, 0.0, path);  // the default: constant velocity
+    core::predict_path(ekf.track(), 2s, 0.1, 0.0, 0.0, path);  // the default: constant velocity
     benchmark::DoNotOptimize(h);
     benchmark::DoNotOptimize(path);
   }

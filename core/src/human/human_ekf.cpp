@@ -95,16 +95,19 @@ HumanTrack predict_track(const HumanTrack& track, Nanos t, const HumanEkfConfig&
 }
 
 void predict_path(const HumanTrack& track, Nanos t0, double dt_s, double time_constant_s,
-                  std::span<Pose2> out) {
+                  double turn_time_constant_s, std::span<Pose2> out) {
   const double t0_s = to_seconds(t0 - track.stamp);
+  // Seconds of motion at the current rate that the prediction amounts to by t (the integral of
+  // exp(-t / tau)); before the stamp the track's own constant-rate model.
+  const auto faded = [](double t, double tau) {
+    return tau > 0.0 && t > 0.0 ? tau * -std::expm1(-t / tau) : t;
+  };
   for (size_t k = 0; k < out.size(); ++k) {
     const double t = t0_s + dt_s * static_cast<double>(k);
-    // Seconds of walking at the current velocity that the prediction amounts to (the
-    // integral of exp(-t / tau)); before the stamp the track's own constant-velocity model.
-    const double s =
-        time_constant_s > 0.0 && t > 0.0 ? time_constant_s * -std::expm1(-t / time_constant_s) : t;
+    const double s = faded(t, time_constant_s);
+    const double s_turn = faded(t, turn_time_constant_s);
     out[k] = Pose2{track.mean()(0) + track.mean()(3) * s, track.mean()(1) + track.mean()(4) * s,
-                   wrap_angle(track.mean()(2) + track.mean()(5) * s)};
+                   wrap_angle(track.mean()(2) + track.mean()(5) * s_turn)};
   }
 }
 

@@ -423,6 +423,17 @@ std::vector<FieldSpec> build() {
        0.0,
        60.0,
        {}},
+      {"human.prediction_turn_time_constant_s",
+       "s",
+       "How long the person's current turn rate lasts in the prediction (q^d's path and the "
+       "barrier's person): the heading turns omega tau (1 - exp(-t / tau)), at most omega tau. "
+       "0: as the velocity (prediction_time_constant_s for q^d, constant for the barrier). A "
+       "turn rate measured mid-turn and carried on swings q^d round the person (2 rad/s over "
+       "tau = 2 s: 240 degrees) and the robot wide of a turning person (docs/EVALUATION.md).",
+       FIELD(human.prediction_turn_time_constant_s),
+       0.0,
+       60.0,
+       {}},
       {"human.gate_probability",
        "-",
        "Chi-square gate of the filter: a pose outside this probability mass is an outlier (0.99, "

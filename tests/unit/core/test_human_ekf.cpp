@@ -219,7 +219,7 @@ TEST(HumanEkf, PredictsToQueryTimesAndIntoTheRobotFrame) {
   track.stamp = 1s;
   track.last_update = 1s;
   std::array<Pose2, 3> path;
-  core::predict_path(track, 1500ms, 0.1, 0.0, path);  // constant velocity
+  core::predict_path(track, 1500ms, 0.1, 0.0, 0.0, path);  // constant velocity
   EXPECT_NEAR(path[0].x_m, 1.5, 1e-12);
   EXPECT_NEAR(path[2].x_m, 1.7, 1e-12);
   EXPECT_NEAR(path[2].y_m, 2.35, 1e-12);
@@ -265,8 +265,8 @@ TEST(HumanEkf, PredictionFadesTheVelocityWithItsTimeConstant) {
   std::array<Pose2, 101> faded{};
   std::array<Pose2, 101> constant{};
   const double tau_s = 2.0;
-  core::predict_path(track, 1s, 0.1, tau_s, faded);
-  core::predict_path(track, 1s, 0.1, 0.0, constant);
+  core::predict_path(track, 1s, 0.1, tau_s, tau_s, faded);
+  core::predict_path(track, 1s, 0.1, 0.0, 0.0, constant);
   EXPECT_NEAR(constant[100].x_m, 15.0, 1e-9) << "constant velocity: 10 s at 1.5 m/s";
   // The first step is nearly constant velocity (1.5 * 2 * (1 - e^-0.05) = 0.1463 m).
   EXPECT_NEAR(faded[1].x_m, 0.1463, 1e-4);
@@ -280,8 +280,33 @@ TEST(HumanEkf, PredictionFadesTheVelocityWithItsTimeConstant) {
   }
   // Before the stamp (a late query of an older track) it is the constant-velocity model.
   std::array<Pose2, 1> before{};
-  core::predict_path(track, 500ms, 0.1, tau_s, before);
+  core::predict_path(track, 500ms, 0.1, tau_s, tau_s, before);
   EXPECT_NEAR(before[0].x_m, -0.75, 1e-12);
 }
+
+// A turn rate measured mid-turn (2 rad/s) carried on with the velocity's 2 s turns the predicted
+// person 4 rad (240 degrees) over the horizon, and q^d behind them round to their front; its own
+// shorter time constant stops the turn where a person's turn ends, and leaves the position alone.
+TEST(HumanEkf, TheTurnRateFadesWithItsOwnTimeConstant) {
+  core::HumanTrack track;
+  track.valid = true;
+  track.mean() << 0.0, 0.0, 0.0, 1.5, 0.0, 2.0;  // 1.5 m/s along x, turning 2 rad/s
+  track.stamp = 1s;
+  std::array<Pose2, 101> as_velocity{};
+  std::array<Pose2, 101> own{};
+  std::array<Pose2, 101> constant{};
+  core::predict_path(track, 1s, 0.1, 2.0, 2.0, as_velocity);
+  core::predict_path(track, 1s, 0.1, 2.0, 0.5, own);
+  core::predict_path(track, 1s, 0.1, 0.0, 0.0, constant);
+  EXPECT_NEAR(as_velocity[100].theta_rad, core::wrap_angle(2.0 * 2.0 * (1.0 - std::exp(-5.0))), 1e-9);
+  EXPECT_NEAR(own[100].theta_rad, 2.0 * 0.5 * (1.0 - std::exp(-20.0)), 1e-9) << "1 rad at most";
+  EXPECT_NEAR(own[5].theta_rad, 2.0 * 0.5 * (1.0 - std::exp(-1.0)), 1e-9);
+  EXPECT_NEAR(constant[10].theta_rad, 2.0, 1e-9) << "0: a constant turn rate";
+  for (size_t k = 0; k < own.size(); ++k) {
+    EXPECT_DOUBLE_EQ(own[k].x_m, as_velocity[k].x_m) << "the position fades with the velocity";
+    EXPECT_DOUBLE_EQ(own[k].y_m, as_velocity[k].y_m);
+  }
+}
+
 
 }  // namespace

@@ -251,6 +251,16 @@ TEST(Config, TheContactTierIsWhereTheFootprintCanTouch) {
   EXPECT_LT(w.contact_threshold, c.contact_threshold) << "a wider robot touches from farther";
 }
 
+TEST(Config, ThePredictedTurnRateTimeConstantReachesTheFilterConfig) {
+  const auto d = firmware::human_ekf_config(*firmware::load_default_config().config);
+  EXPECT_DOUBLE_EQ(d.prediction_turn_time_constant_s, 0.0) << "the default: as the velocity";
+  const auto set = load_config_text("human:\n  prediction_turn_time_constant_s: 0.5\n", "test.yaml");
+  ASSERT_TRUE(set.ok()) << set.errors[0].to_string();
+  EXPECT_DOUBLE_EQ(firmware::human_ekf_config(*set.config).prediction_turn_time_constant_s, 0.5);
+  EXPECT_FALSE(
+      load_config_text("human:\n  prediction_turn_time_constant_s: -1\n", "test.yaml").ok());
+}
+
 TEST(Config, TheTrackingFrameIsAChoiceThatReachesTheController) {
   expect_error(load_config_text("mppi:\n  tracking_frame: odom\n", "test.yaml"), 2,
                "mppi.tracking_frame", "not one of");

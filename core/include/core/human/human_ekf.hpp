@@ -35,6 +35,9 @@ struct HumanEkfConfig {
   // this time constant predicts the displacement v tau (1 - exp(-t / tau)): constant velocity at
   // first, at most v tau in all. 0: constant velocity over the whole horizon.
   double prediction_time_constant_s = 0.0;
+  // The same for the person's turn rate (0: as the velocity: prediction_time_constant_s for
+  // q^d's path, constant for the barrier's person). See predict_path.
+  double prediction_turn_time_constant_s = 0.0;
 };
 
 using HumanVector = Eigen::Matrix<double, 6, 1>;
@@ -99,11 +102,13 @@ class HumanEkf {
 // The track moved forward (or backward) to `t` with the model; covariance grows with |dt|.
 HumanTrack predict_track(const HumanTrack& track, Nanos t, const HumanEkfConfig& config);
 
-// The person's predicted pose at t0, t0 + dt, ... (out.size() poses): the track's velocity and
-// turn rate, fading with `time_constant_s` after the track's stamp (0: constant velocity; see
-// HumanEkfConfig::prediction_time_constant_s).
+// The person's predicted pose at t0, t0 + dt, ... (out.size() poses): the track's velocity
+// fading with `time_constant_s` after the track's stamp (0: constant velocity; see
+// HumanEkfConfig::prediction_time_constant_s), its turn rate with `turn_time_constant_s` (0:
+// constant turn rate). A turn rate measured mid-turn and carried on for seconds turns the
+// predicted person round and round: a person's turn lasts about a second.
 void predict_path(const HumanTrack& track, Nanos t0, double dt_s, double time_constant_s,
-                  std::span<Pose2> out);
+                  double turn_time_constant_s, std::span<Pose2> out);
 // The person's position at t (before or after the track's stamp), constant velocity.
 Point2 position_at(const HumanTrack& track, Nanos t);
 
