@@ -574,10 +574,9 @@ bool Daemon::run_controller(Nanos now, core::BodyVelocity& requested) {
   const double turn_s = human_config_.prediction_turn_time_constant_s;
   core::predict_path(track->value, now, mppi_.config().step_s, 0.0, turn_s, person_path_);
   if (human_config_.prediction_time_constant_s > 0.0) {
-    core::predict_path(track->value, now, mppi_.config().step_s,
-                       human_config_.prediction_time_constant_s,
-                       turn_s > 0.0 ? turn_s : human_config_.prediction_time_constant_s,
-                       goal_path_);
+    core::predict_path(
+        track->value, now, mppi_.config().step_s, human_config_.prediction_time_constant_s,
+        turn_s > 0.0 ? turn_s : human_config_.prediction_time_constant_s, goal_path_);
   } else {
     std::copy(person_path_.begin(), person_path_.end(), goal_path_.begin());
   }

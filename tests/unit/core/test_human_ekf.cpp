@@ -298,7 +298,8 @@ TEST(HumanEkf, TheTurnRateFadesWithItsOwnTimeConstant) {
   core::predict_path(track, 1s, 0.1, 2.0, 2.0, as_velocity);
   core::predict_path(track, 1s, 0.1, 2.0, 0.5, own);
   core::predict_path(track, 1s, 0.1, 0.0, 0.0, constant);
-  EXPECT_NEAR(as_velocity[100].theta_rad, core::wrap_angle(2.0 * 2.0 * (1.0 - std::exp(-5.0))), 1e-9);
+  EXPECT_NEAR(as_velocity[100].theta_rad, core::wrap_angle(2.0 * 2.0 * (1.0 - std::exp(-5.0))),
+              1e-9);
   EXPECT_NEAR(own[100].theta_rad, 2.0 * 0.5 * (1.0 - std::exp(-20.0)), 1e-9) << "1 rad at most";
   EXPECT_NEAR(own[5].theta_rad, 2.0 * 0.5 * (1.0 - std::exp(-1.0)), 1e-9);
   EXPECT_NEAR(constant[10].theta_rad, 2.0, 1e-9) << "0: a constant turn rate";
@@ -307,6 +308,5 @@ TEST(HumanEkf, TheTurnRateFadesWithItsOwnTimeConstant) {
     EXPECT_DOUBLE_EQ(own[k].y_m, as_velocity[k].y_m);
   }
 }
-
 
 }  // namespace

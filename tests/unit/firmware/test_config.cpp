@@ -254,7 +254,8 @@ TEST(Config, TheContactTierIsWhereTheFootprintCanTouch) {
 TEST(Config, ThePredictedTurnRateTimeConstantReachesTheFilterConfig) {
   const auto d = firmware::human_ekf_config(*firmware::load_default_config().config);
   EXPECT_DOUBLE_EQ(d.prediction_turn_time_constant_s, 0.0) << "the default: as the velocity";
-  const auto set = load_config_text("human:\n  prediction_turn_time_constant_s: 0.5\n", "test.yaml");
+  const auto set =
+      load_config_text("human:\n  prediction_turn_time_constant_s: 0.5\n", "test.yaml");
   ASSERT_TRUE(set.ok()) << set.errors[0].to_string();
   EXPECT_DOUBLE_EQ(firmware::human_ekf_config(*set.config).prediction_turn_time_constant_s, 0.5);
   EXPECT_FALSE(
