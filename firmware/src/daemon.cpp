@@ -571,15 +571,8 @@ bool Daemon::run_controller(Nanos now, core::BodyVelocity& requested) {
   // human.prediction_time_constant_s (2 s by default), so it stays on the costmap; at constant
   // velocity (0) it runs ~15 m ahead over the 10 s horizon, off the map (docs/EVALUATION.md).
   // The turn rate fades with human.prediction_turn_time_constant_s when set (0: as the velocity).
-  const double turn_s = human_config_.prediction_turn_time_constant_s;
-  core::predict_path(track->value, now, mppi_.config().step_s, 0.0, turn_s, person_path_);
-  if (human_config_.prediction_time_constant_s > 0.0) {
-    core::predict_path(
-        track->value, now, mppi_.config().step_s, human_config_.prediction_time_constant_s,
-        turn_s > 0.0 ? turn_s : human_config_.prediction_time_constant_s, goal_path_);
-  } else {
-    std::copy(person_path_.begin(), person_path_.end(), goal_path_.begin());
-  }
+  core::predict_person_and_goal_paths(track->value, now, mppi_.config().step_s, human_config_,
+                                      person_path_, goal_path_);
   // q^d is a point of the person's interactive space: it walks with them over the horizon.
   const core::Pose2 goal_in_person = goal->value.person_odom.inverse() * goal->value.goal_odom;
   for (core::Pose2& g : goal_path_)

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cmath>
 #include <memory>
 #include <random>
 #include <vector>
@@ -17,6 +16,8 @@
 #include "core/planner/interactive_space.hpp"
 #include "core/policy/mlp_policy.hpp"
 #include "core/policy/observation.hpp"
+#include "firmware/config/config_loader.hpp"
+#include "firmware/daemon.hpp"
 
 using namespace std::chrono_literals;
 
@@ -67,10 +68,12 @@ Warm& warm(int threads, int min_ess, int guide) {
     core::MppiConfig cfg;  // K = 100, M = 2000
     cfg.threads = threads;
     cfg.min_effective_samples = min_ess;
-    if (guide > 0) {
-      cfg.guide_samples = true;
-      cfg.contact_cost = 100000.0;
-      cfg.contact_threshold = core::cost_at_distance(core::CostmapConfig{}, std::hypot(0.35, 0.30));
+    if (guide > 0) {  // exactly what the daemon ships (config/companiond.yaml)
+      const core::MppiConfig shipped =
+          firmware::mppi_config(*firmware::load_default_config().config);
+      cfg.guide_samples = shipped.guide_samples;
+      cfg.contact_cost = shipped.contact_cost;
+      cfg.contact_threshold = shipped.contact_threshold;
     }
     w->mppi = std::make_unique<core::Mppi>(cfg);
     w->map = scene();

@@ -111,6 +111,19 @@ void predict_path(const HumanTrack& track, Nanos t0, double dt_s, double time_co
   }
 }
 
+void predict_person_and_goal_paths(const HumanTrack& track, Nanos t0, double dt_s,
+                                   const HumanEkfConfig& config, std::span<Pose2> person,
+                                   std::span<Pose2> goal) {
+  const double turn_s = config.prediction_turn_time_constant_s;
+  predict_path(track, t0, dt_s, 0.0, turn_s, person);
+  const double tau_s = config.prediction_time_constant_s;
+  if (tau_s > 0.0) {
+    predict_path(track, t0, dt_s, tau_s, turn_s > 0.0 ? turn_s : tau_s, goal);
+  } else {  // the same prediction: no second pass
+    std::copy_n(person.begin(), std::min(person.size(), goal.size()), goal.begin());
+  }
+}
+
 Point2 position_at(const HumanTrack& track, Nanos t) {
   const double dt = to_seconds(t - track.stamp);
   return Point2{track.mean()(0) + track.mean()(3) * dt, track.mean()(1) + track.mean()(4) * dt};

@@ -89,10 +89,8 @@ void write_costmap_snapshot(const firmware::Daemon& daemon, const firmware::Daem
     // Where the controller expects the person and q^d over its horizon (as run_controller).
     std::vector<core::Pose2> person(static_cast<size_t>(cfg.mppi.horizon_steps) + 1);
     std::vector<core::Pose2> goal(person.size());
-    const double turn_s = cfg.human.prediction_turn_time_constant_s;
-    core::predict_path(track->value, now, cfg.mppi.step_s, 0.0, turn_s, person);
-    core::predict_path(track->value, now, cfg.mppi.step_s, cfg.human.prediction_time_constant_s,
-                       turn_s > 0.0 ? turn_s : cfg.human.prediction_time_constant_s, goal);
+    core::predict_person_and_goal_paths(track->value, now, cfg.mppi.step_s,
+                                        firmware::human_ekf_config(cfg), person, goal);
     const core::Pose2 goal_in_person = m.person_odom.inverse() * m.goal_odom;
     const auto every = static_cast<size_t>(std::max(1L, std::lround(1.0 / cfg.mppi.step_s)));
     for (size_t k = 0; k < person.size(); k += every) {

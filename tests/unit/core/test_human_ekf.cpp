@@ -309,4 +309,35 @@ TEST(HumanEkf, TheTurnRateFadesWithItsOwnTimeConstant) {
   }
 }
 
+// One rule for the daemon's controller and the evaluation's snapshots: the barrier's person at
+// constant velocity, q^d's carrier faded, both turning as prediction_turn_time_constant_s says.
+TEST(HumanEkf, PersonAndGoalPathsShareTheTurnRule) {
+  core::HumanTrack track;
+  track.valid = true;
+  track.mean() << 0.0, 0.0, 0.0, 1.5, 0.0, 2.0;
+  track.stamp = 1s;
+  std::array<Pose2, 11> person{};
+  std::array<Pose2, 11> goal{};
+  core::HumanEkfConfig c;
+  c.prediction_time_constant_s = 2.0;
+  core::predict_person_and_goal_paths(track, 1s, 0.1, c, person, goal);
+  const double fade_1s = 2.0 * (1.0 - std::exp(-0.5));
+  EXPECT_NEAR(person[10].x_m, 1.5, 1e-9) << "the barrier's person: constant velocity";
+  EXPECT_NEAR(person[10].theta_rad, 2.0, 1e-9) << "turn 0: as its velocity, constant";
+  EXPECT_NEAR(goal[10].x_m, 1.5 * fade_1s, 1e-9);
+  EXPECT_NEAR(goal[10].theta_rad, 2.0 * fade_1s, 1e-9) << "turn 0: as its velocity, faded";
+  c.prediction_turn_time_constant_s = 0.5;
+  core::predict_person_and_goal_paths(track, 1s, 0.1, c, person, goal);
+  const double turn_1s = 0.5 * (1.0 - std::exp(-2.0));
+  EXPECT_NEAR(person[10].theta_rad, 2.0 * turn_1s, 1e-9);
+  EXPECT_NEAR(goal[10].theta_rad, 2.0 * turn_1s, 1e-9);
+  EXPECT_NEAR(goal[10].x_m, 1.5 * fade_1s, 1e-9) << "the position keeps its own fading";
+  c.prediction_time_constant_s = 0.0;
+  core::predict_person_and_goal_paths(track, 1s, 0.1, c, person, goal);
+  for (size_t k = 0; k < person.size(); ++k) {
+    EXPECT_DOUBLE_EQ(goal[k].x_m, person[k].x_m) << "no fading: q^d's carrier is the person";
+    EXPECT_DOUBLE_EQ(goal[k].theta_rad, person[k].theta_rad);
+  }
+}
+
 }  // namespace

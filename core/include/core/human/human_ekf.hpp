@@ -109,6 +109,13 @@ HumanTrack predict_track(const HumanTrack& track, Nanos t, const HumanEkfConfig&
 // predicted person round and round: a person's turn lasts about a second.
 void predict_path(const HumanTrack& track, Nanos t0, double dt_s, double time_constant_s,
                   double turn_time_constant_s, std::span<Pose2> out);
+// What the controller predicts over its horizon, one rule for every caller: `person`, for the
+// barrier, at constant velocity (the conservative place they may be); `goal`, the path q^d is
+// carried on, with the velocity fading as config.prediction_time_constant_s. Both turn with the
+// rate fading as config.prediction_turn_time_constant_s (0: as their velocity).
+void predict_person_and_goal_paths(const HumanTrack& track, Nanos t0, double dt_s,
+                                   const HumanEkfConfig& config, std::span<Pose2> person,
+                                   std::span<Pose2> goal);
 // The person's position at t (before or after the track's stamp), constant velocity.
 Point2 position_at(const HumanTrack& track, Nanos t);
 
