@@ -112,8 +112,8 @@ void predict_path(const HumanTrack& track, Nanos t0, double dt_s, double time_co
 }
 
 void predict_person_and_goal_paths(const HumanTrack& track, Nanos t0, double dt_s,
-                                   const HumanEkfConfig& config, std::span<Pose2> person,
-                                   std::span<Pose2> goal) {
+                                   const HumanEkfConfig& config, const Pose2& goal_in_person,
+                                   std::span<Pose2> person, std::span<Pose2> goal) {
   const double turn_s = config.prediction_turn_time_constant_s;
   predict_path(track, t0, dt_s, 0.0, turn_s, person);
   const double tau_s = config.prediction_time_constant_s;
@@ -122,6 +122,8 @@ void predict_person_and_goal_paths(const HumanTrack& track, Nanos t0, double dt_
   } else {  // the same prediction: no second pass
     std::copy_n(person.begin(), std::min(person.size(), goal.size()), goal.begin());
   }
+  for (Pose2& g : goal)
+    g = g * goal_in_person;
 }
 
 Point2 position_at(const HumanTrack& track, Nanos t) {

@@ -90,12 +90,12 @@ void write_costmap_snapshot(const firmware::Daemon& daemon, const firmware::Daem
     std::vector<core::Pose2> person(static_cast<size_t>(cfg.mppi.horizon_steps) + 1);
     std::vector<core::Pose2> goal(person.size());
     core::predict_person_and_goal_paths(track->value, now, cfg.mppi.step_s,
-                                        firmware::human_ekf_config(cfg), person, goal);
-    const core::Pose2 goal_in_person = m.person_odom.inverse() * m.goal_odom;
+                                        firmware::human_ekf_config(cfg),
+                                        m.person_odom.inverse() * m.goal_odom, person, goal);
     const auto every = static_cast<size_t>(std::max(1L, std::lround(1.0 / cfg.mppi.step_s)));
     for (size_t k = 0; k < person.size(); k += every) {
       m.predicted_person.push_back(person[k]);
-      m.predicted_goal.push_back(goal[k] * goal_in_person);
+      m.predicted_goal.push_back(goal[k]);
     }
   }
   if (const auto c = daemon.control_status().read(); c && c->value.tracking) {

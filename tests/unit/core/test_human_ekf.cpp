@@ -320,23 +320,33 @@ TEST(HumanEkf, PersonAndGoalPathsShareTheTurnRule) {
   std::array<Pose2, 11> goal{};
   core::HumanEkfConfig c;
   c.prediction_time_constant_s = 2.0;
-  core::predict_person_and_goal_paths(track, 1s, 0.1, c, person, goal);
+  core::predict_person_and_goal_paths(track, 1s, 0.1, c, Pose2{}, person, goal);
   const double fade_1s = 2.0 * (1.0 - std::exp(-0.5));
   EXPECT_NEAR(person[10].x_m, 1.5, 1e-9) << "the barrier's person: constant velocity";
   EXPECT_NEAR(person[10].theta_rad, 2.0, 1e-9) << "turn 0: as its velocity, constant";
   EXPECT_NEAR(goal[10].x_m, 1.5 * fade_1s, 1e-9);
   EXPECT_NEAR(goal[10].theta_rad, 2.0 * fade_1s, 1e-9) << "turn 0: as its velocity, faded";
   c.prediction_turn_time_constant_s = 0.5;
-  core::predict_person_and_goal_paths(track, 1s, 0.1, c, person, goal);
+  core::predict_person_and_goal_paths(track, 1s, 0.1, c, Pose2{}, person, goal);
   const double turn_1s = 0.5 * (1.0 - std::exp(-2.0));
   EXPECT_NEAR(person[10].theta_rad, 2.0 * turn_1s, 1e-9);
   EXPECT_NEAR(goal[10].theta_rad, 2.0 * turn_1s, 1e-9);
   EXPECT_NEAR(goal[10].x_m, 1.5 * fade_1s, 1e-9) << "the position keeps its own fading";
   c.prediction_time_constant_s = 0.0;
-  core::predict_person_and_goal_paths(track, 1s, 0.1, c, person, goal);
+  core::predict_person_and_goal_paths(track, 1s, 0.1, c, Pose2{}, person, goal);
   for (size_t k = 0; k < person.size(); ++k) {
     EXPECT_DOUBLE_EQ(goal[k].x_m, person[k].x_m) << "no fading: q^d's carrier is the person";
     EXPECT_DOUBLE_EQ(goal[k].theta_rad, person[k].theta_rad);
+  }
+  // q^d 1 m behind the person it was chosen for is held 1 m behind the predicted carrier.
+  c.prediction_time_constant_s = 2.0;
+  std::array<Pose2, 11> carrier{};
+  core::predict_person_and_goal_paths(track, 1s, 0.1, c, Pose2{}, person, carrier);
+  core::predict_person_and_goal_paths(track, 1s, 0.1, c, Pose2{-1.0, 0.0, 0.0}, person, goal);
+  for (size_t k = 0; k < goal.size(); ++k) {
+    EXPECT_NEAR(goal[k].x_m, carrier[k].x_m - std::cos(carrier[k].theta_rad), 1e-12);
+    EXPECT_NEAR(goal[k].y_m, carrier[k].y_m - std::sin(carrier[k].theta_rad), 1e-12);
+    EXPECT_NEAR(goal[k].theta_rad, carrier[k].theta_rad, 1e-12);
   }
 }
 
