@@ -114,8 +114,10 @@ void predict_path(const HumanTrack& track, Nanos t0, double dt_s, double time_co
 void predict_person_and_goal_paths(const HumanTrack& track, Nanos t0, double dt_s,
                                    const HumanEkfConfig& config, const Pose2& goal_in_person,
                                    std::span<Pose2> person, std::span<Pose2> goal) {
+  // The barrier's person: constant velocity and turn rate, the conservative place they may be
+  // (a person turning round toward the robot is predicted near it; faded, they walk off).
+  predict_path(track, t0, dt_s, 0.0, 0.0, person);
   const double turn_s = config.prediction_turn_time_constant_s;
-  predict_path(track, t0, dt_s, 0.0, turn_s, person);
   const double tau_s = config.prediction_time_constant_s;
   if (tau_s > 0.0) {
     predict_path(track, t0, dt_s, tau_s, turn_s > 0.0 ? turn_s : tau_s, goal);

@@ -425,11 +425,12 @@ std::vector<FieldSpec> build() {
        {}},
       {"human.prediction_turn_time_constant_s",
        "s",
-       "How long the person's current turn rate lasts in the prediction (q^d's path and the "
-       "barrier's person): the heading turns omega tau (1 - exp(-t / tau)), at most omega tau. "
-       "0: as the velocity (prediction_time_constant_s for q^d, constant for the barrier). A "
-       "turn rate measured mid-turn and carried on swings q^d round the person (2 rad/s over "
-       "tau = 2 s: 240 degrees) and the robot wide of a turning person (docs/EVALUATION.md).",
+       "How long the person's current turn rate lasts in the prediction that carries q^d over "
+       "the controller's horizon: the heading turns omega tau (1 - exp(-t / tau)), at most "
+       "omega tau. 0: as the velocity (prediction_time_constant_s). A turn rate measured "
+       "mid-turn and carried on swings q^d round the person (2 rad/s over tau = 2 s: 240 "
+       "degrees; docs/EVALUATION.md). The barrier's person keeps a constant turn rate either "
+       "way: a person turning round toward the robot stays predicted near it.",
        FIELD(human.prediction_turn_time_constant_s),
        0.0,
        60.0,

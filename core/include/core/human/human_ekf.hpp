@@ -110,11 +110,11 @@ HumanTrack predict_track(const HumanTrack& track, Nanos t, const HumanEkfConfig&
 void predict_path(const HumanTrack& track, Nanos t0, double dt_s, double time_constant_s,
                   double turn_time_constant_s, std::span<Pose2> out);
 // What the controller predicts over its horizon, one rule for every caller: `person`, for the
-// barrier, at constant velocity (the conservative place they may be); `goal`, q^d's path: the
-// chosen point held in the frame of a carrier person whose velocity fades as
-// config.prediction_time_constant_s (`goal_in_person`: q^d in the frame of the person it was
-// chosen for). Both turn with the rate fading as config.prediction_turn_time_constant_s (0: as
-// their velocity).
+// barrier, at constant velocity and turn rate (the conservative place they may be); `goal`, q^d's
+// path: the chosen point held in the frame of a carrier person whose velocity fades as
+// config.prediction_time_constant_s and whose turn rate fades as
+// config.prediction_turn_time_constant_s (0: as the velocity; `goal_in_person`: q^d in the frame
+// of the person it was chosen for).
 void predict_person_and_goal_paths(const HumanTrack& track, Nanos t0, double dt_s,
                                    const HumanEkfConfig& config, const Pose2& goal_in_person,
                                    std::span<Pose2> person, std::span<Pose2> goal);
