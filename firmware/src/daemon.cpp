@@ -570,7 +570,8 @@ bool Daemon::run_controller(Nanos now, core::BodyVelocity& requested) {
   // may be. q^d, the point to be at, walks with them on a velocity that fades with
   // human.prediction_time_constant_s (2 s by default), so it stays on the costmap; at constant
   // velocity (0) it runs ~15 m ahead over the 10 s horizon, off the map (docs/EVALUATION.md).
-  // The turn rate fades with human.prediction_turn_time_constant_s when set (0: as the velocity).
+  // q^d's turn rate fades with human.prediction_turn_time_constant_s when set (0: as the
+  // velocity); the barrier's person keeps a constant turn rate.
   // q^d is a point of the person's interactive space: it walks with them over the horizon.
   const core::Pose2 goal_in_person = goal->value.person_odom.inverse() * goal->value.goal_odom;
   core::predict_person_and_goal_paths(track->value, now, mppi_.config().step_s, human_config_,

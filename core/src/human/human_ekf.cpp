@@ -119,9 +119,9 @@ void predict_person_and_goal_paths(const HumanTrack& track, Nanos t0, double dt_
   predict_path(track, t0, dt_s, 0.0, 0.0, person);
   const double turn_s = config.prediction_turn_time_constant_s;
   const double tau_s = config.prediction_time_constant_s;
-  if (tau_s > 0.0) {
+  if (tau_s > 0.0 || turn_s > 0.0) {
     predict_path(track, t0, dt_s, tau_s, turn_s > 0.0 ? turn_s : tau_s, goal);
-  } else {  // the same prediction: no second pass
+  } else {  // nothing fades: the barrier's prediction, without a second pass
     std::copy_n(person.begin(), std::min(person.size(), goal.size()), goal.begin());
   }
   for (Pose2& g : goal)

@@ -336,6 +336,11 @@ TEST(HumanEkf, TheBarriersPersonKeepsTurningWhileQdsCarrierFades) {
   EXPECT_NEAR(goal[10].x_m, 1.5 * fade_1s, 1e-9) << "the position keeps its own fading";
   c.prediction_time_constant_s = 0.0;
   core::predict_person_and_goal_paths(track, 1s, 0.1, c, Pose2{}, person, goal);
+  EXPECT_NEAR(goal[10].x_m, 1.5, 1e-9) << "velocity 0: constant, as the barrier's";
+  EXPECT_NEAR(goal[10].theta_rad, 2.0 * turn_1s, 1e-9) << "the turn still fades on its own";
+  EXPECT_NEAR(person[10].theta_rad, 2.0, 1e-9);
+  c.prediction_turn_time_constant_s = 0.0;
+  core::predict_person_and_goal_paths(track, 1s, 0.1, c, Pose2{}, person, goal);
   for (size_t k = 0; k < person.size(); ++k) {
     EXPECT_DOUBLE_EQ(goal[k].x_m, person[k].x_m) << "no fading: q^d's carrier is the person";
     EXPECT_DOUBLE_EQ(goal[k].theta_rad, person[k].theta_rad);
