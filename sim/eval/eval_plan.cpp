@@ -40,17 +40,20 @@ std::optional<std::vector<Case>> expand_cases(const std::string& name, int rando
     c.trials = random_trials;
     return c;
   };
+  // The dead ends are seeded worlds of their own: `random_trials` of them.
+  auto dead_end_case = [&] { return Case{"dead_end", "dead_end", random_trials, {}, 0, 0}; };
   for (const auto& info : sim::builtin_scenarios()) {
     if (name == info.name) {
       if (name == "random") return std::vector<Case>{random_case("random")};
+      if (name == "dead_end") return std::vector<Case>{dead_end_case()};
       return std::vector<Case>{Case{info.name, info.name, 1, {}, 0, 0}};
     }
   }
-  if (name == "paper") {
+  if (name == "paper") {  // the paper's scenarios 1-7
     for (const auto& info : sim::builtin_scenarios()) {
       if (std::string(info.name) == "random") {
         out.push_back(random_case("random"));
-      } else {
+      } else if (std::string(info.name) != "dead_end") {
         out.push_back(Case{info.name, info.name, 1, {}, 0, 0});
       }
     }
@@ -82,7 +85,7 @@ std::optional<std::vector<Case>> expand_cases(const std::string& name, int rando
     return out;
   }
   // Constrained worlds: the random world of the same seed with obstacles beside the walk, their
-  // surfaces C m from the person's path: where adaptive selection should pay.
+  // surfaces C m from the person's path, and the dead ends: where adaptive selection should pay.
   auto clutter_case = [&](double clearance_m) {
     Case c = random_case(fmt::format("clutter-{}", clearance_m));
     c.random.beside_walk_clearance_m = clearance_m;
@@ -92,6 +95,7 @@ std::optional<std::vector<Case>> expand_cases(const std::string& name, int rando
     for (double clearance_m : {1.2, 1.0, 0.8}) {
       out.push_back(clutter_case(clearance_m));
     }
+    out.push_back(dead_end_case());
     return out;
   }
   double v = 0;
@@ -121,7 +125,7 @@ std::optional<std::vector<Case>> expand_cases(const std::string& name, int rando
   }
   error = fmt::format(
       "unknown case '{}': a scenario (open, static_obstacle, pedestrian_front_right, corridor, "
-      "doorway, crossing, random), a group (paper, crowds, speeds, sizes, constrained), or "
+      "doorway, crossing, random, dead_end), a group (paper, crowds, speeds, sizes, constrained), or "
       "crowd-N, speed-V, size-AxB, clutter-C",
       name);
   return std::nullopt;

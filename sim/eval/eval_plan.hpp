@@ -29,10 +29,11 @@ struct Case {
   double ellipse_a_m = 0, ellipse_b_m = 0;  // > 0: interaction-space size of this case
 };
 
-// Case names: the built-ins (open ... crossing, random), "crowd-N", "speed-V", "size-AxB",
-// "clutter-C" (obstacles beside the walk, C m from it), "paper" (scenarios 1-6 + random),
-// "crowds" (5/10/15/20), "speeds" (0.75/1.2/1.7), "sizes" (a few a x b), "constrained"
-// (clutter 1.2/1.0/0.8). Unknown names: nullopt and `error`.
+// Case names: the built-ins (open ... crossing, random, dead_end), "crowd-N", "speed-V",
+// "size-AxB", "clutter-C" (obstacles beside the walk, C m from it), "paper" (scenarios 1-6 +
+// random), "crowds" (5/10/15/20), "speeds" (0.75/1.2/1.7), "sizes" (a few a x b), "constrained"
+// (clutter 1.2/1.0/0.8 and dead_end). Random and dead_end cases get `random_trials` seeds.
+// Unknown names: nullopt and `error`.
 std::optional<std::vector<Case>> expand_cases(const std::string& name, int random_trials,
                                               std::string& error);
 

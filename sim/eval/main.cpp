@@ -142,12 +142,12 @@ int run(int argc, char** argv) {
   app.add_option(
          "--case", case_names,
          "cases: open static_obstacle pedestrian_front_right corridor doorway crossing "
-         "random | paper crowds speeds sizes constrained | crowd-N speed-V size-AxB clutter-C")
+         "random dead_end | paper crowds speeds sizes constrained | crowd-N speed-V size-AxB clutter-C")
       ->delimiter(',');
   app.add_option("--method", method_names,
                  "methods: objective fixed_behind fixed_side pid policy (policy needs policy.file)")
       ->delimiter(',');
-  app.add_option("--trials", trials, "trials of the random cases (paper: 50)")
+  app.add_option("--trials", trials, "trials of the random and dead_end cases (paper: 50)")
       ->check(CLI::Range(1, 100000));
   app.add_option("--seed", seed, "first seed (trial i uses seed + i)");
   app.add_option("--jobs", jobs, "trials in parallel (default: the cores)")

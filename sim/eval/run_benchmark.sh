@@ -2,13 +2,13 @@
 # The full evaluation of docs/EVALUATION.md, in one command: scenarios 1-6, the 50-trial random
 # benchmark (scenario 7), crowd densities 5/10/15/20, walking speeds 0.75/1.2/1.7 m/s, three
 # interaction-space sizes, the constrained worlds (obstacles beside the walk 1.2/1.0/0.8 m from
-# it) and both recorded-pedestrian files, for every method; then the plots
+# it, and dead-end corridors) and both recorded-pedestrian files, for every method; then the plots
 # and one report (OUT/REPORT.md: every table, the wall time, trials per minute).
 #
 #   sim/eval/run_benchmark.sh [OUT]          (default: eval-full; ~2 h on 2 cores)
 #
 # Environment: EVAL (the companion-eval binary, default build/release/sim/companion-eval),
-# TRIALS (random trials of scenario 7, default 50), VARIANT_TRIALS (per crowd/speed/size/clutter case,
+# TRIALS (random trials of scenario 7, default 50), VARIANT_TRIALS (per crowd/speed/size/clutter/dead-end case,
 # default 10), METHODS (default objective,fixed_behind,fixed_side,pid; add policy with a policy
 # file in CONFIG), CONFIG (a daemon configuration for every trial, default: built-in defaults),
 # DURATION_S (cut every trial to this long: CI's reduced run), JOBS (trials in parallel), STEPS

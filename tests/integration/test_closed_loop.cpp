@@ -443,6 +443,36 @@ TEST(ClosedLoop, ShutdownIsNotFooledByACommandStillInTheBasesPipeline) {
   EXPECT_FALSE(moved_after_complete) << "complete at " << complete_at;
 }
 
+// ---- leading: the dead end -------------------------------------------------------------------
+
+// The person walks into a corridor with a closed end, turns round and walks out: behind them is
+// where the robot cannot get without passing them, so it leads them out. Dead-end seed 5 (2.2 m
+// wide): before a q^d ahead of the person rode the barrier's (constant-velocity) person, q^d's
+// faded prediction told the robot to wait in front of the walking person, who came within the
+// ellipse; the robot dodged into the wall (docs/EVALUATION.md, "Dead ends").
+TEST(ClosedLoop, LeadsThePersonOutOfADeadEnd) {
+  SimRunOptions o;
+  o.config = defaults();
+  o.scenario = *sim::make_scenario("dead_end", 5);
+  const double mouth_x = o.scenario.world.segments[0].a.x_m;
+  int walking_out = 0, ahead = 0;
+  o.script = [&](double, sim::SimWorld& w, firmware::Daemon&) {
+    const core::Pose2 p = w.person_pose();
+    const core::Pose2 r = w.robot_pose();
+    // Walking back out (facing -x), well inside the corridor.
+    if (std::cos(p.theta_rad) < -0.9 && p.x_m > mouth_x + 1.0) {
+      ++walking_out;
+      if (r.x_m < p.x_m) ++ahead;
+    }
+  };
+  const auto r = sim::run_simulation(o);
+  print("dead_end-5", r);
+  EXPECT_TRUE(r.metrics.success) << r.metrics.failure;
+  ASSERT_GT(walking_out, 100);
+  EXPECT_GT(ahead, 0.9 * walking_out) << "leading, not squeezing past";
+  EXPECT_LT(r.metrics.uncomfortable_s, 0.5);
+}
+
 // ---- the evaluation's baselines, as configuration -------------------------------------------
 
 TEST(ClosedLoop, FixedPointBaselinesHoldTheirPointOfTheInteractiveSpace) {

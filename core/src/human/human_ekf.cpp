@@ -119,7 +119,14 @@ void predict_person_and_goal_paths(const HumanTrack& track, Nanos t0, double dt_
   predict_path(track, t0, dt_s, 0.0, 0.0, person);
   const double turn_s = config.prediction_turn_time_constant_s;
   const double tau_s = config.prediction_time_constant_s;
-  if (tau_s > 0.0 || turn_s > 0.0) {
+  // A q^d ahead of the person (the robot leads) rides the barrier's person: on a faded carrier
+  // the barrier's person would walk into it within seconds, and the robot, told to wait there,
+  // stops in front of a walking person (the dead ends of docs/EVALUATION.md). Behind or beside
+  // them a faded q^d only lags, which is safe. (The point straight beside them is x ~ 1e-16 m
+  // by rounding: the margin keeps it beside.)
+  constexpr double kAheadM = 0.05;
+  const bool leading = goal_in_person.x_m > kAheadM;
+  if (!leading && (tau_s > 0.0 || turn_s > 0.0)) {
     predict_path(track, t0, dt_s, tau_s, turn_s > 0.0 ? turn_s : tau_s, goal);
   } else {  // nothing fades: the barrier's prediction, without a second pass
     std::copy_n(person.begin(), std::min(person.size(), goal.size()), goal.begin());

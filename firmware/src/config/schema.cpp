@@ -416,7 +416,9 @@ std::vector<FieldSpec> build() {
        "How long the person's current velocity lasts in the prediction that carries q^d over the "
        "controller's horizon: q^d moves v tau (1 - exp(-t / tau)), at most v tau (0: constant "
        "velocity, ~15 m in 10 s, off the costmap, where the robot lagged and lost the person). "
-       "The barrier keeps constant velocity. Tracking this closely is safe with "
+       "The barrier keeps constant velocity, and so does a q^d ahead of the person (the robot "
+       "leads: on a faded carrier the walking person would reach it). Tracking this closely is "
+       "safe with "
        "closing_speed.robot_decel_mps2 on; without it, measured, it touched a turning person "
        "more (docs/EVALUATION.md).",
        FIELD(human.prediction_time_constant_s),

@@ -17,11 +17,11 @@ constexpr double kStartDelayS = 4.0;
 constexpr double kTailS = 3.0;  // standing at the end, so the run ends at rest
 
 Scenario base_scenario(const char* name, const char* description,
-                       const std::vector<Waypoint>& walk_points) {
+                       const std::vector<Waypoint>& walk_points, const CornerLimits& corner = {}) {
   Scenario s;
   s.name = name;
   s.description = description;
-  s.person = walk(walk_points, kStartDelayS);
+  s.person = walk(walk_points, kStartDelayS, 0.05, corner);
   const core::Pose2 p0 = s.person.pose_at(0.0);
   s.robot_start = p0 * core::Pose2{-1.0, 0.0, 0.0};  // 1 m behind the person, same heading
   s.duration_s = s.person.end_s() + kTailS;
@@ -98,6 +98,38 @@ double uniform(std::mt19937& rng, double a, double b) {
   return std::uniform_real_distribution<double>(a, b)(rng);
 }
 
+// A corridor with a closed end (seeded: 2.0-2.6 m wide, 6-11 m long, 0.8-1.4 m/s, 0-2 s at the
+// end): the person walks in, turns round at the end and walks out, then on in the open. Behind
+// them is then where the robot cannot get without passing them in the corridor: the robot has
+// to lead them out. People start and stop at 1 m/s^2 here (a sudden turn back into the robot
+// at walking speed is not a thing people do, and no robot could brake for it).
+Scenario dead_end(uint32_t seed) {
+  std::mt19937 rng(seed);
+  const double width_m = uniform(rng, 2.0, 2.6);
+  const double length_m = uniform(rng, 6.0, 11.0);
+  const double speed = uniform(rng, 0.8, 1.4);
+  const double pause_s = uniform(rng, 0.0, 2.0);
+  const double out_turn = uniform(rng, -1.75, 1.75);  // where they go once out
+  constexpr double kEntryM = 2.0;  // the corridor's mouth, from the start
+  const double end_x = kEntryM + length_m;
+  // They turn 0.6 m before the end wall, and walk on 4-6 m past the mouth.
+  const double back_x = -uniform(rng, 0.5, 2.0);
+  const double on_m = uniform(rng, 4.0, 6.0);
+  Scenario s = base_scenario(
+      "dead_end", "a corridor with a closed end: the person turns back",
+      {{{0, 0}},
+       {{end_x - 0.6, 0}, speed, std::max(pause_s, 0.05)},
+       {{back_x, 0}, speed},
+       {{back_x - on_m * std::cos(out_turn), on_m * std::sin(out_turn)}, speed}},
+      CornerLimits{.start_stop_accel_mps2 = 1.0});
+  s.name = fmt::format("dead_end-{}", seed);
+  const double half = width_m / 2;
+  s.world.add_wall({kEntryM, -half}, {end_x, -half});
+  s.world.add_wall({kEntryM, half}, {end_x, half});
+  s.world.add_wall({end_x, -half}, {end_x, half});
+  return s;
+}
+
 // The constrained worlds' obstacles beside the walk (RandomScenarioOptions), from their own
 // generator and after everything else, so the seed's world is unchanged beneath them.
 void add_obstacles_beside_walk(Scenario& s, uint32_t seed, double clearance_m) {
@@ -154,6 +186,7 @@ const std::vector<ScenarioInfo>& builtin_scenarios() {
       {"doorway", "5: a doorway with a sudden turn behind it"},
       {"crossing", "6: three pedestrians crossing between robot and person"},
       {"random", "7: random static obstacles + 10 pedestrians, 0.7-1.5 m/s (seeded)"},
+      {"dead_end", "constrained: a corridor with a closed end, the person turns back (seeded)"},
   };
   return kList;
 }
@@ -166,6 +199,7 @@ std::optional<Scenario> make_scenario(const std::string& name, uint32_t seed) {
   if (name == "doorway" || name == "5") return doorway();
   if (name == "crossing" || name == "6") return crossing();
   if (name == "random" || name == "7") return random_scenario(seed, {});
+  if (name == "dead_end") return dead_end(seed);
   return std::nullopt;
 }
 

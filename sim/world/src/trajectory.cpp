@@ -76,6 +76,11 @@ struct WalkPiece {
   double t1_s = 0;
   core::Point2 from;
   core::Point2 to;  // lines (and standing: from == to)
+  // Lines walked at a speed changing evenly from v0 to v1 (starting and stopping); otherwise
+  // at a constant speed.
+  bool eased = false;
+  double v0_mps = 0;
+  double v1_mps = 0;
   bool arc = false;
   core::Point2 centre;
   double radius_m = 0;
@@ -84,7 +89,12 @@ struct WalkPiece {
 
   [[nodiscard]] core::Point2 at(double t_s) const {
     const double span = t1_s - t0_s;
-    const double u = span > 0 ? std::clamp((t_s - t0_s) / span, 0.0, 1.0) : 1.0;
+    double u = span > 0 ? std::clamp((t_s - t0_s) / span, 0.0, 1.0) : 1.0;
+    if (eased && span > 0) {
+      const double tau = u * span;
+      const double walked = v0_mps * tau + 0.5 * (v1_mps - v0_mps) / span * tau * tau;
+      u = walked / (0.5 * (v0_mps + v1_mps) * span);
+    }
     if (arc) {
       const double a = start_angle_rad + u * turn_rad;
       return {centre.x_m + radius_m * std::cos(a), centre.y_m + radius_m * std::sin(a)};
@@ -113,6 +123,27 @@ class WalkBuilder {
   void line_to(core::Point2 to, double speed_mps) {
     add_line(to, distance(here_, to) / std::max(speed_mps, 0.05));
   }
+  // A line from standing and/or to standing, speeding up and slowing down at accel_mps2 (on a
+  // leg too short for the full speed, to the speed it allows).
+  void line_to_eased(core::Point2 to, double speed_mps, bool from_rest, bool to_rest,
+                     double accel_mps2) {
+    const double len = distance(here_, to);
+    const int ramps = (from_rest ? 1 : 0) + (to_rest ? 1 : 0);
+    if (ramps == 0 || len < 1e-9) {
+      line_to(to, speed_mps);
+      return;
+    }
+    // Each ramp takes v^2 / 2a of the leg.
+    const double v = std::min(std::max(speed_mps, 0.05), std::sqrt(2.0 * accel_mps2 * len / ramps));
+    const double ramp_m = v * v / (2.0 * accel_mps2);
+    const core::Point2 dir{(to.x_m - here_.x_m) / len, (to.y_m - here_.y_m) / len};
+    auto along = [&](double d) { return core::Point2{here_.x_m + d * dir.x_m, here_.y_m + d * dir.y_m}; };
+    const core::Point2 cruise_from = from_rest ? along(ramp_m) : here_;
+    const core::Point2 cruise_to = to_rest ? along(len - ramp_m) : to;
+    if (from_rest) add_eased(cruise_from, 0.0, v, v / accel_mps2);
+    if (distance(here_, cruise_to) > 1e-9) line_to(cruise_to, v);
+    if (to_rest) add_eased(to, v, 0.0, v / accel_mps2);
+  }
   // The arc from here (on the incoming leg, heading `in_dir`) turning by `turn_rad`.
   void arc(core::Point2 in_dir, double turn_rad, double radius_m, double speed_mps) {
     const double side = turn_rad > 0 ? 1.0 : -1.0;
@@ -135,6 +166,13 @@ class WalkBuilder {
   [[nodiscard]] const std::vector<WalkPiece>& pieces() const { return pieces_; }
 
  private:
+  void add_eased(core::Point2 to, double v0_mps, double v1_mps, double duration_s) {
+    add_line(to, duration_s);
+    WalkPiece& p = pieces_.back();
+    p.eased = true;
+    p.v0_mps = v0_mps;
+    p.v1_mps = v1_mps;
+  }
   void add_line(core::Point2 to, double duration_s) {
     WalkPiece p;
     p.t0_s = t_s_;
@@ -157,9 +195,11 @@ Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s, double s
   std::vector<TimedPose> out;
   if (waypoints.empty()) return Trajectory(out);
   const bool round_corners = corner.lateral_accel_mps2 > 0 && corner.turn_rate_radps > 0;
+  const bool ease = corner.start_stop_accel_mps2 > 0;
   WalkBuilder b(waypoints.front().p);
   b.stand(start_s);
   b.stand(waypoints.front().pause_s);
+  bool from_rest = true;  // the leg about to be walked starts from standing
   for (size_t i = 1; i < waypoints.size(); ++i) {
     const Waypoint& w = waypoints[i];
     const core::Point2 a = waypoints[i - 1].p;
@@ -167,8 +207,14 @@ Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s, double s
     const bool last = i + 1 == waypoints.size();
     const double len_out = last ? 0.0 : distance(w.p, waypoints[i + 1].p);
     if (!round_corners || last || w.pause_s > 0 || len_in < 1e-6 || len_out < 1e-6) {
-      b.line_to(w.p, w.speed_mps);
+      const bool to_rest = last || w.pause_s > 0;
+      if (ease) {
+        b.line_to_eased(w.p, w.speed_mps, from_rest, to_rest, corner.start_stop_accel_mps2);
+      } else {
+        b.line_to(w.p, w.speed_mps);
+      }
       b.stand(w.pause_s);
+      from_rest = to_rest;
       continue;
     }
     const core::Point2 in{(w.p.x_m - a.x_m) / len_in, (w.p.y_m - a.y_m) / len_in};
@@ -177,7 +223,12 @@ Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s, double s
     const double turn = std::atan2(in.x_m * out_dir.y_m - in.y_m * out_dir.x_m,
                                    in.x_m * out_dir.x_m + in.y_m * out_dir.y_m);
     if (std::abs(turn) < 1e-3) {
-      b.line_to(w.p, w.speed_mps);
+      if (ease) {
+        b.line_to_eased(w.p, w.speed_mps, from_rest, false, corner.start_stop_accel_mps2);
+      } else {
+        b.line_to(w.p, w.speed_mps);
+      }
+      from_rest = false;
       continue;
     }
     // The tightest arc at walking speed v: r = max(v^2 / a_lat, v / omega). Its tangent points
@@ -192,8 +243,14 @@ Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s, double s
       v = std::min({v, std::sqrt(corner.lateral_accel_mps2 * r), corner.turn_rate_radps * r});
     }
     const double cut = r * half_tan;
-    b.line_to({w.p.x_m - cut * in.x_m, w.p.y_m - cut * in.y_m}, w.speed_mps);
+    const core::Point2 arc_start{w.p.x_m - cut * in.x_m, w.p.y_m - cut * in.y_m};
+    if (ease) {
+      b.line_to_eased(arc_start, w.speed_mps, from_rest, false, corner.start_stop_accel_mps2);
+    } else {
+      b.line_to(arc_start, w.speed_mps);
+    }
     b.arc(in, turn, r, v);
+    from_rest = false;
   }
   const double t = b.end_s();
   const auto& pieces = b.pieces();

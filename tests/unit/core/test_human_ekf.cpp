@@ -355,6 +355,18 @@ TEST(HumanEkf, TheBarriersPersonKeepsTurningWhileQdsCarrierFades) {
     EXPECT_NEAR(goal[k].y_m, carrier[k].y_m - std::sin(carrier[k].theta_rad), 1e-12);
     EXPECT_NEAR(goal[k].theta_rad, carrier[k].theta_rad, 1e-12);
   }
+  // q^d 1 m ahead (the robot leads) rides the barrier's person: on the faded carrier the
+  // barrier's person, walking on, would reach it (1.5 m/s against at most 3 m of carrier).
+  core::predict_person_and_goal_paths(track, 1s, 0.1, c, Pose2{1.0, 0.0, 0.0}, person, goal);
+  for (size_t k = 0; k < goal.size(); ++k) {
+    EXPECT_NEAR(goal[k].x_m, person[k].x_m + std::cos(person[k].theta_rad), 1e-12) << k;
+    EXPECT_NEAR(goal[k].y_m, person[k].y_m + std::sin(person[k].theta_rad), 1e-12) << k;
+  }
+  // Beside them it fades, as behind, also where rounding puts it a hair ahead (the point of W
+  // at 90 degrees: a cos(pi / 2) = 6e-17 m).
+  core::predict_person_and_goal_paths(track, 1s, 0.1, c, Pose2{std::cos(std::numbers::pi / 2), 0.7, 0.0},
+                                      person, goal);
+  EXPECT_NEAR(goal[10].x_m, carrier[10].x_m - 0.7 * std::sin(carrier[10].theta_rad), 1e-9);
 }
 
 }  // namespace

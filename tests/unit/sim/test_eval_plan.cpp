@@ -37,9 +37,12 @@ TEST(EvalPlan, GroupsExpandToTheReferenceCases) {
 
   auto constrained = eval::expand_cases("constrained", 3, error);
   ASSERT_TRUE(constrained);
-  ASSERT_EQ(constrained->size(), 3U);
+  ASSERT_EQ(constrained->size(), 4U);
   EXPECT_EQ((*constrained)[1].name, "clutter-1");
   EXPECT_EQ((*constrained)[1].random.beside_walk_clearance_m, 1.0);
+  EXPECT_EQ((*constrained)[3].name, "dead_end");
+  EXPECT_EQ((*constrained)[3].trials, 3) << "seeded dead ends, as many as random trials";
+  for (const auto& c : *paper) EXPECT_NE(c.name, "dead_end") << "not one of the paper's 1-7";
   EXPECT_EQ(paper->back().random.beside_walk_clearance_m, 0) << "the benchmark stays as it was";
 
   for (const char* bad : {"moon", "crowd-x", "speed-0", "size-1.2", "size-9x9", "crowd-1000",
@@ -93,6 +96,36 @@ std::pair<double, double> walk_clearance(const sim::Scenario& s, double closed_m
   return {nearest, static_cast<double>(closed) / static_cast<double>(s.person.samples().size())};
 }
 }  // namespace
+
+TEST(EvalPlan, DeadEndsAreSeededCorridorsThePersonWalksOutOfAgain) {
+  std::string error;
+  const auto cases = eval::expand_cases("dead_end", 4, error);
+  ASSERT_TRUE(cases);
+  ASSERT_EQ(cases->size(), 1U);
+  const sim::Scenario a = eval::make_world(cases->front(), 3);
+  const sim::Scenario again = eval::make_world(cases->front(), 3);
+  const sim::Scenario b = eval::make_world(cases->front(), 4);
+  EXPECT_EQ(a.name, "dead_end-3");
+  ASSERT_EQ(a.world.segments.size(), 3U) << "two side walls and the end";
+  EXPECT_EQ(a.world.segments[2].a.x_m, again.world.segments[2].a.x_m) << "same seed, same world";
+  EXPECT_NE(a.world.segments[2].a.x_m, b.world.segments[2].a.x_m) << "another seed, another";
+  // The person goes in to near the end wall, and comes back out past the corridor's mouth,
+  // without touching its walls on the way (they turn round 0.6 m from the end wall; the side
+  // walls are at least 1 m from them).
+  const double end_x = a.world.segments[2].a.x_m;
+  const double mouth_x = a.world.segments[0].a.x_m;
+  double deepest = -1e9;
+  bool out_again = false;
+  for (const auto& tp : a.person.samples()) {
+    deepest = std::max(deepest, tp.pose.x_m);
+    if (deepest > end_x - 1.0 && tp.pose.x_m < mouth_x - 0.5) out_again = true;
+    EXPECT_GT(a.world.distance({tp.pose.x_m, tp.pose.y_m}), a.person_radius_m + 0.3) << tp.t_s;
+  }
+  EXPECT_GT(deepest, end_x - 1.0);
+  EXPECT_TRUE(out_again);
+  // It starts with the robot 1 m behind the person, outside the corridor.
+  EXPECT_LT(a.robot_start.x_m, mouth_x);
+}
 
 TEST(EvalPlan, ConstrainedWorldsAreTheSeedsWorldWithObstaclesBesideTheWalk) {
   std::string error;

@@ -142,6 +142,34 @@ TEST(Walk, APauseAtACornerTurnsOnTheSpot) {
   EXPECT_NEAR(t.end_s(), 7.0, 1e-9);
 }
 
+TEST(Walk, StartsAndStopsAtTheGivenAccelerationWhenAsked) {
+  sim::CornerLimits limits;
+  limits.start_stop_accel_mps2 = 1.0;
+  // 1.2 m/s on 6 m legs, 1 s at the far end, back: 0.72 m and 1.2 s for each speed ramp.
+  const auto t = sim::walk({{{0, 0}}, {{6, 0}, 1.2, 1.0}, {{0, 0}, 1.2}}, 0.0, 0.01, limits);
+  const double leg_s = 2 * 1.2 + (6.0 - 2 * 0.72) / 1.2;
+  EXPECT_NEAR(t.end_s(), 2 * leg_s + 1.0, 1e-6);
+  EXPECT_NEAR(t.pose_at(0.6).x_m, 0.5 * 0.6 * 0.6, 1e-3) << "speeding up: x = a t^2 / 2";
+  EXPECT_NEAR(t.velocity_at(0.6).x_m, 0.6, 0.02);
+  EXPECT_NEAR(t.velocity_at(3.0).x_m, 1.2, 1e-3) << "then at the leg's speed";
+  EXPECT_NEAR(t.velocity_at(leg_s - 0.3).x_m, 0.3, 0.02) << "slowing down into the pause";
+  EXPECT_NEAR(t.pose_at(leg_s + 0.5).x_m, 6.0, 1e-9) << "standing at the end";
+  EXPECT_NEAR(t.velocity_at(leg_s + 1.0 + 0.6).x_m, -0.6, 0.02) << "and speeding up again";
+  // No step anywhere faster than the ramp allows.
+  const auto& s = t.samples();
+  for (size_t i = 2; i < s.size(); ++i) {
+    const double dt = s[i].t_s - s[i - 1].t_s;
+    if (dt < 1e-6 || s[i - 1].t_s - s[i - 2].t_s < 1e-6) continue;
+    const double v1 = (s[i].pose.x_m - s[i - 1].pose.x_m) / dt;
+    const double v0 = (s[i - 1].pose.x_m - s[i - 2].pose.x_m) / (s[i - 1].t_s - s[i - 2].t_s);
+    EXPECT_LE(std::abs(v1 - v0) / dt, 1.0 * 1.05 + 1e-6) << s[i].t_s;
+  }
+  // Without it (every benchmark walk), the same walk starts and stops at once.
+  const auto sudden = sim::walk({{{0, 0}}, {{6, 0}, 1.2, 1.0}, {{0, 0}, 1.2}}, 0.0, 0.01);
+  EXPECT_NEAR(sudden.velocity_at(0.1).x_m, 1.2, 1e-6);
+  EXPECT_NEAR(sudden.end_s(), 2 * 5.0 + 1.0, 1e-6);
+}
+
 TEST(Walk, HeadingIsKeptWhileStanding) {
   // Recorded positions jitter by a centimetre while a person stands: no spinning heading.
   std::vector<sim::TimedPose> s;

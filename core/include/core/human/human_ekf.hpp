@@ -114,7 +114,8 @@ void predict_path(const HumanTrack& track, Nanos t0, double dt_s, double time_co
 // path: the chosen point held in the frame of a carrier person whose velocity fades as
 // config.prediction_time_constant_s and whose turn rate fades as
 // config.prediction_turn_time_constant_s (0: as the velocity; `goal_in_person`: q^d in the frame
-// of the person it was chosen for).
+// of the person it was chosen for); a q^d ahead of the person (x > 0) rides the barrier's person
+// instead, so the barrier's person never walks into it.
 void predict_person_and_goal_paths(const HumanTrack& track, Nanos t0, double dt_s,
                                    const HumanEkfConfig& config, const Pose2& goal_in_person,
                                    std::span<Pose2> person, std::span<Pose2> goal);

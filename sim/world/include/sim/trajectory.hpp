@@ -43,6 +43,10 @@ struct Waypoint {
 struct CornerLimits {
   double lateral_accel_mps2 = 3.0;  // v^2 / r while turning
   double turn_rate_radps = 3.0;     // v / r: ~170 deg/s, a quick turn in one step
+  // > 0: the walker speeds up from standing and slows down to standing (at a pause and at the
+  // end) this evenly; 0: at once, as every walk of the benchmark worlds (changing it there
+  // would change every trial). Turns taken on the spot while paused stay sudden.
+  double start_stop_accel_mps2 = 0.0;
 };
 // Sampled every `step_s`, starting at `start_s` (standing at the first waypoint until then).
 Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s = 0.0, double step_s = 0.05,
