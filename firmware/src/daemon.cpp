@@ -114,6 +114,7 @@ core::InteractiveSpaceConfig interactive_space_config(const DaemonConfig& cfg) {
   c.alpha = cfg.objective.alpha;
   c.beta = cfg.objective.beta;
   c.gamma = cfg.objective.gamma;
+  c.delta = cfg.objective.delta;
   return c;
 }
 

@@ -1,5 +1,6 @@
 #include "core/planner/interactive_space.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -43,8 +44,9 @@ void InteractiveSpace::update(const Pose2& person_base, const Pose2& robot_odom,
     c.dist_human_m = std::hypot(p.x_m - person_base.x_m, p.y_m - person_base.y_m);
     c.dist_robot_m = std::hypot(p.x_m, p.y_m);
     c.cost = costmap.at(c.odom.x_m, c.odom.y_m);
-    c.objective =
-        config_.alpha * c.dist_human_m + config_.beta * c.dist_robot_m + config_.gamma * c.cost;
+    const double ahead_of_person_m = std::max(0.0, config_.a_m * cos_phi_[i]);
+    c.objective = config_.alpha * c.dist_human_m + config_.beta * c.dist_robot_m +
+                  config_.gamma * c.cost + config_.delta * ahead_of_person_m;
     c.free = c.cost < config_.cost_threshold;
     free_count_ += c.free ? 1U : 0U;
   }

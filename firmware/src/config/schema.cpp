@@ -712,6 +712,17 @@ std::vector<FieldSpec> build() {
        0.0,
        1000.0,
        {}},
+      {"objective.delta",
+       "1/m",
+       "delta: weight of how far a candidate is ahead of the person (a cos phi_i when positive) "
+       "in G; ours, not the paper's. 0: the paper's G. Above 0 the robot leads only while it is "
+       "ahead already and the point behind is farther from it by more than delta/beta metres "
+       "(or the point behind is not free): a leading robot on the outside of a turn drops back "
+       "behind the person instead of being cut off by what they turn past.",
+       FIELD(objective.delta),
+       0.0,
+       1000.0,
+       {}},
       {"mppi.horizon_steps",
        "count",
        "K: prediction steps (paper: 100).",

@@ -105,6 +105,43 @@ TEST(InteractiveSpace, DefaultWeightsSendALaggingRobotBehindThePersonNotBesideTh
   EXPECT_GT(aside_m, 0.0) << "on the robot's side of the person's track";
 }
 
+TEST(InteractiveSpace, DeltaDropsAPushedAsideLeaderBehindButKeepsOneThatIsAhead) {
+  // The person at the origin walks along +x. The default delta = 4 per metre ahead; the paper's G
+  // has none.
+  const core::InteractiveSpaceConfig cfg;
+  ASSERT_DOUBLE_EQ(cfg.delta, 4.0);
+  core::InteractiveSpaceConfig paper;
+  paper.delta = 0.0;
+  const auto chosen_x_in_person = [&](const core::InteractiveSpaceConfig& c,
+                                      const core::Pose2& robot_odom) {
+    core::InteractiveSpace w(c);
+    // The person seen from the robot: base_link = the robot's frame.
+    const core::Pose2 person_base = robot_odom.inverse() * core::Pose2{0.0, 0.0, 0.0};
+    w.update(person_base, robot_odom, room(std::nullopt));
+    const auto s = core::select_by_objective(w);
+    EXPECT_EQ(s.status, core::GoalStatus::kOk);
+    return robot_odom.apply({s.goal_base.x_m, s.goal_base.y_m}).x_m;
+  };
+  // A robot right at the point ahead (leading out of a dead end) keeps it: behind is 2 m
+  // farther, beta 2 m = 8 > delta a = 4.
+  EXPECT_GT(chosen_x_in_person(cfg, core::Pose2{1.0, 0.0, 0.0}), 0.9);
+  // Pushed 1.1 m to the side and level with the person's front (the outside of a turn), the
+  // point behind is only 0.6 m farther: it is chosen (the paper's G, delta 0, keeps the front).
+  const core::Pose2 pushed{0.45, -1.1, 0.0};
+  EXPECT_LT(chosen_x_in_person(cfg, pushed), -0.5);
+  EXPECT_GT(chosen_x_in_person(paper, pushed), 0.5);
+  // Points behind and beside the person are not charged: G differs by delta max(0, x) only.
+  core::InteractiveSpace with(cfg);
+  core::InteractiveSpace without(paper);
+  with.update(core::Pose2{2.0, 0.0, 0.0}, core::Pose2{}, room(std::nullopt));
+  without.update(core::Pose2{2.0, 0.0, 0.0}, core::Pose2{}, room(std::nullopt));
+  for (size_t i = 0; i < with.candidates().size(); ++i) {
+    const double x_in_person = with.candidates()[i].base.x_m - 2.0;
+    EXPECT_NEAR(with.candidates()[i].objective - without.candidates()[i].objective,
+                4.0 * std::max(0.0, x_in_person), 1e-9);
+  }
+}
+
 // A ring of obstacles 0.9 m around (cx, 0) (a crowd): every ellipse point there is too close.
 core::Costmap ring_around(double cx) {
   core::VoxelGridConfig gc;

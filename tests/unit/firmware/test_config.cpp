@@ -231,6 +231,7 @@ TEST(Config, ControllerParametersComeFromTheConfigurationAsInThePaper) {
   EXPECT_DOUBLE_EQ(w.alpha, core_defaults.alpha);
   EXPECT_DOUBLE_EQ(w.beta, core_defaults.beta);
   EXPECT_DOUBLE_EQ(w.gamma, core_defaults.gamma);
+  EXPECT_DOUBLE_EQ(w.delta, core_defaults.delta);
   EXPECT_DOUBLE_EQ(w.a_m, core_defaults.a_m);
   EXPECT_DOUBLE_EQ(w.b_m, core_defaults.b_m);
 }

@@ -5,7 +5,9 @@
 //      person's pose (the point's heading is the person's heading);
 //   P: the points of W whose costmap cost l(q) is below R (cost scale:
 //   core/perception/costmap.hpp); G(P_i) = alpha |P_i - q_h| + beta |P_i| + gamma l(P_i) (distances
-//   in base_link, metres); the objective selector picks argmin G over P. With P empty (the person
+//   in base_link, metres), plus ours, not the paper's: delta max(0, x^h_i), x^h_i = a cos phi_i how
+//   far the point is ahead of the person (a leading robot is cut off by whatever the person turns
+//   past; behind them is the way they came); the objective selector picks argmin G over P. With P empty (the person
 //   is surrounded) there is no goal, and the reason says so.
 // Pure; fixed-size buffers set at construction.
 #include <cstdint>
@@ -26,6 +28,7 @@ struct InteractiveSpaceConfig {
   double alpha = -16.0;          // weight of the distance to the person (< 0: the far points)
   double beta = 4.0;             // weight of the distance to the robot (= the shipped yaml)
   double gamma = 0.02;           // weight of the costmap cost
+  double delta = 4.0;            // weight of how far the point is ahead of the person (ours)
 };
 
 struct Candidate {

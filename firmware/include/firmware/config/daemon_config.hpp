@@ -116,6 +116,7 @@ struct DaemonConfig {
     double alpha = 0;
     double beta = 0;
     double gamma = 0;
+    double delta = 0;
   } objective;
 
   struct Policy {
