@@ -139,10 +139,10 @@ int run(int argc, char** argv) {
   int follow = -1;
   double duration_s = 0;
   bool samples = false;
-  app.add_option(
-         "--case", case_names,
-         "cases: open static_obstacle pedestrian_front_right corridor doorway crossing "
-         "random dead_end | paper crowds speeds sizes constrained | crowd-N speed-V size-AxB clutter-C")
+  app.add_option("--case", case_names,
+                 "cases: open static_obstacle pedestrian_front_right corridor doorway crossing "
+                 "random dead_end | paper crowds speeds sizes constrained | crowd-N speed-V "
+                 "size-AxB clutter-C")
       ->delimiter(',');
   app.add_option("--method", method_names,
                  "methods: objective fixed_behind fixed_side pid policy (policy needs policy.file)")

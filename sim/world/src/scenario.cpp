@@ -110,18 +110,19 @@ Scenario dead_end(uint32_t seed) {
   const double speed = uniform(rng, 0.8, 1.4);
   const double pause_s = uniform(rng, 0.0, 2.0);
   const double out_turn = uniform(rng, -1.75, 1.75);  // where they go once out
-  constexpr double kEntryM = 2.0;  // the corridor's mouth, from the start
+  constexpr double kEntryM = 2.0;                     // the corridor's mouth, from the start
   const double end_x = kEntryM + length_m;
-  // They turn 0.6 m before the end wall, and walk on 4-6 m past the mouth.
+  // They turn 0.6 m before the end wall, walk back out to 0.5-2 m short of where they started
+  // (2.5-4 m past the mouth), and on 4-6 m in a seeded direction.
   const double back_x = -uniform(rng, 0.5, 2.0);
   const double on_m = uniform(rng, 4.0, 6.0);
-  Scenario s = base_scenario(
-      "dead_end", "a corridor with a closed end: the person turns back",
-      {{{0, 0}},
-       {{end_x - 0.6, 0}, speed, std::max(pause_s, 0.05)},
-       {{back_x, 0}, speed},
-       {{back_x - on_m * std::cos(out_turn), on_m * std::sin(out_turn)}, speed}},
-      CornerLimits{.start_stop_accel_mps2 = 1.0});
+  Scenario s =
+      base_scenario("dead_end", "a corridor with a closed end: the person turns back",
+                    {{{0, 0}},
+                     {{end_x - 0.6, 0}, speed, std::max(pause_s, 0.05)},
+                     {{back_x, 0}, speed},
+                     {{back_x - on_m * std::cos(out_turn), on_m * std::sin(out_turn)}, speed}},
+                    CornerLimits{.start_stop_accel_mps2 = 1.0});
   s.name = fmt::format("dead_end-{}", seed);
   const double half = width_m / 2;
   s.world.add_wall({kEntryM, -half}, {end_x, -half});

@@ -124,12 +124,13 @@ class WalkBuilder {
     add_line(to, distance(here_, to) / std::max(speed_mps, 0.05));
   }
   // A line from standing and/or to standing, speeding up and slowing down at accel_mps2 (on a
-  // leg too short for the full speed, to the speed it allows).
+  // leg too short for the full speed, to the speed it allows); accel_mps2 <= 0: at once, as
+  // line_to.
   void line_to_eased(core::Point2 to, double speed_mps, bool from_rest, bool to_rest,
                      double accel_mps2) {
     const double len = distance(here_, to);
     const int ramps = (from_rest ? 1 : 0) + (to_rest ? 1 : 0);
-    if (ramps == 0 || len < 1e-9) {
+    if (accel_mps2 <= 0 || ramps == 0 || len < 1e-9) {
       line_to(to, speed_mps);
       return;
     }
@@ -137,7 +138,9 @@ class WalkBuilder {
     const double v = std::min(std::max(speed_mps, 0.05), std::sqrt(2.0 * accel_mps2 * len / ramps));
     const double ramp_m = v * v / (2.0 * accel_mps2);
     const core::Point2 dir{(to.x_m - here_.x_m) / len, (to.y_m - here_.y_m) / len};
-    auto along = [&](double d) { return core::Point2{here_.x_m + d * dir.x_m, here_.y_m + d * dir.y_m}; };
+    auto along = [&](double d) {
+      return core::Point2{here_.x_m + d * dir.x_m, here_.y_m + d * dir.y_m};
+    };
     const core::Point2 cruise_from = from_rest ? along(ramp_m) : here_;
     const core::Point2 cruise_to = to_rest ? along(len - ramp_m) : to;
     if (from_rest) add_eased(cruise_from, 0.0, v, v / accel_mps2);
@@ -195,7 +198,6 @@ Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s, double s
   std::vector<TimedPose> out;
   if (waypoints.empty()) return Trajectory(out);
   const bool round_corners = corner.lateral_accel_mps2 > 0 && corner.turn_rate_radps > 0;
-  const bool ease = corner.start_stop_accel_mps2 > 0;
   WalkBuilder b(waypoints.front().p);
   b.stand(start_s);
   b.stand(waypoints.front().pause_s);
@@ -208,11 +210,7 @@ Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s, double s
     const double len_out = last ? 0.0 : distance(w.p, waypoints[i + 1].p);
     if (!round_corners || last || w.pause_s > 0 || len_in < 1e-6 || len_out < 1e-6) {
       const bool to_rest = last || w.pause_s > 0;
-      if (ease) {
-        b.line_to_eased(w.p, w.speed_mps, from_rest, to_rest, corner.start_stop_accel_mps2);
-      } else {
-        b.line_to(w.p, w.speed_mps);
-      }
+      b.line_to_eased(w.p, w.speed_mps, from_rest, to_rest, corner.start_stop_accel_mps2);
       b.stand(w.pause_s);
       from_rest = to_rest;
       continue;
@@ -223,11 +221,7 @@ Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s, double s
     const double turn = std::atan2(in.x_m * out_dir.y_m - in.y_m * out_dir.x_m,
                                    in.x_m * out_dir.x_m + in.y_m * out_dir.y_m);
     if (std::abs(turn) < 1e-3) {
-      if (ease) {
-        b.line_to_eased(w.p, w.speed_mps, from_rest, false, corner.start_stop_accel_mps2);
-      } else {
-        b.line_to(w.p, w.speed_mps);
-      }
+      b.line_to_eased(w.p, w.speed_mps, from_rest, false, corner.start_stop_accel_mps2);
       from_rest = false;
       continue;
     }
@@ -244,11 +238,7 @@ Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s, double s
     }
     const double cut = r * half_tan;
     const core::Point2 arc_start{w.p.x_m - cut * in.x_m, w.p.y_m - cut * in.y_m};
-    if (ease) {
-      b.line_to_eased(arc_start, w.speed_mps, from_rest, false, corner.start_stop_accel_mps2);
-    } else {
-      b.line_to(arc_start, w.speed_mps);
-    }
+    b.line_to_eased(arc_start, w.speed_mps, from_rest, false, corner.start_stop_accel_mps2);
     b.arc(in, turn, r, v);
     from_rest = false;
   }

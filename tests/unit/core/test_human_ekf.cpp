@@ -364,8 +364,8 @@ TEST(HumanEkf, TheBarriersPersonKeepsTurningWhileQdsCarrierFades) {
   }
   // Beside them it fades, as behind, also where rounding puts it a hair ahead (the point of W
   // at 90 degrees: a cos(pi / 2) = 6e-17 m).
-  core::predict_person_and_goal_paths(track, 1s, 0.1, c, Pose2{std::cos(std::numbers::pi / 2), 0.7, 0.0},
-                                      person, goal);
+  core::predict_person_and_goal_paths(
+      track, 1s, 0.1, c, Pose2{std::cos(std::numbers::pi / 2), 0.7, 0.0}, person, goal);
   EXPECT_NEAR(goal[10].x_m, carrier[10].x_m - 0.7 * std::sin(carrier[10].theta_rad), 1e-9);
 }
 

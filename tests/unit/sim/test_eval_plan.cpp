@@ -42,7 +42,8 @@ TEST(EvalPlan, GroupsExpandToTheReferenceCases) {
   EXPECT_EQ((*constrained)[1].random.beside_walk_clearance_m, 1.0);
   EXPECT_EQ((*constrained)[3].name, "dead_end");
   EXPECT_EQ((*constrained)[3].trials, 3) << "seeded dead ends, as many as random trials";
-  for (const auto& c : *paper) EXPECT_NE(c.name, "dead_end") << "not one of the paper's 1-7";
+  for (const auto& c : *paper)
+    EXPECT_NE(c.name, "dead_end") << "not one of the paper's 1-7";
   EXPECT_EQ(paper->back().random.beside_walk_clearance_m, 0) << "the benchmark stays as it was";
 
   for (const char* bad : {"moon", "crowd-x", "speed-0", "size-1.2", "size-9x9", "crowd-1000",

@@ -7,8 +7,8 @@
 //   core/perception/costmap.hpp); G(P_i) = alpha |P_i - q_h| + beta |P_i| + gamma l(P_i) (distances
 //   in base_link, metres), plus ours, not the paper's: delta max(0, x^h_i), x^h_i = a cos phi_i how
 //   far the point is ahead of the person (a leading robot is cut off by whatever the person turns
-//   past; behind them is the way they came); the objective selector picks argmin G over P. With P empty (the person
-//   is surrounded) there is no goal, and the reason says so.
+//   past; behind them is the way they came); the objective selector picks argmin G over P. With P
+//   empty (the person is surrounded) there is no goal, and the reason says so.
 // Pure; fixed-size buffers set at construction.
 #include <cstdint>
 #include <span>
