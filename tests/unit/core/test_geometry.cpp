@@ -61,4 +61,20 @@ TEST(PoseHistory, InterpolatesHoldsBrieflyAndForgetsTheOldest) {
   EXPECT_EQ(*h.newest_stamp(), 80ms);
 }
 
+// A query newer than the newest pose (a 120 Hz tracker frame after the 50 Hz odometry) is where
+// the robot has got to at its velocity since: held, a person seen from a robot driving at 1 m/s
+// was placed up to 4 cm behind where they were.
+TEST(PoseHistory, CarriesTheNewestPoseOnAtItsVelocity) {
+  core::PoseHistory h(4, 40ms);
+  h.add({0, 0, 0}, 0ms, {1.0, 0.0, 0.0});
+  h.add({0.02, 0, std::numbers::pi / 2}, 20ms, {1.0, 0.5, 0.2});  // heading +y
+  EXPECT_NEAR(h.at(10ms)->x_m, 0.01, 1e-12) << "between poses: interpolated, not carried";
+  const auto later = h.at(50ms);  // 30 ms on: 3 cm forward (+y), 1.5 cm left (-x)
+  ASSERT_TRUE(later);
+  EXPECT_NEAR(later->x_m, 0.02 - 0.015, 1e-12);
+  EXPECT_NEAR(later->y_m, 0.03, 1e-12);
+  EXPECT_NEAR(later->theta_rad, std::numbers::pi / 2 + 0.006, 1e-12);
+  EXPECT_FALSE(h.at(61ms)) << "no further than max_extrapolation";
+}
+
 }  // namespace

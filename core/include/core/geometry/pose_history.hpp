@@ -11,14 +11,24 @@
 
 namespace core {
 
+// A body's velocity in its own frame (base_link: forward, left, counter-clockwise).
+struct BodyRate {
+  double vx_mps = 0.0, vy_mps = 0.0, wz_radps = 0.0;
+};
+
+// `pose` moved on for `dt_s` at `rate` (first order: the base's odometry comes every 20 ms).
+[[nodiscard]] Pose2 carried(const Pose2& pose, const BodyRate& rate, double dt_s);
+
 class PoseHistory {
  public:
-  // `max_extrapolation`: a query newer than the newest pose holds the newest pose up to this
-  // far ahead (the base reports at 50 Hz, the tracker at 120 Hz); beyond it, no answer.
+  // `max_extrapolation`: a query newer than the newest pose carries the newest pose on at its
+  // velocity up to this far ahead (the base reports at 50 Hz, the tracker at 120 Hz: most
+  // tracker frames are newer than the newest odometry); beyond it, no answer.
   PoseHistory(size_t capacity, Nanos max_extrapolation);
 
-  // Stamps must increase; an older or equal stamp is ignored (returns false).
-  bool add(const Pose2& pose, Nanos stamp);
+  // Stamps must increase; an older or equal stamp is ignored (returns false). `rate`: the
+  // body's velocity at `pose` (zero: a newer query holds the pose).
+  bool add(const Pose2& pose, Nanos stamp, const BodyRate& rate = {});
   // Interpolated pose at `t`; nullopt when `t` is before the oldest pose kept, too far past the
   // newest, or the history is empty.
   [[nodiscard]] std::optional<Pose2> at(Nanos t) const;
@@ -29,6 +39,7 @@ class PoseHistory {
   struct Entry {
     Pose2 pose;
     Nanos stamp{0};
+    BodyRate rate;
   };
   [[nodiscard]] const Entry& entry(size_t i) const;  // 0 = oldest
 
