@@ -112,9 +112,11 @@ void Mppi::prepare_guide_block(const MppiInputs& in) {
   auto toward = [](double from, double to, double step) {
     return std::clamp(to, from - step, from + step);
   };
-  // The steering law: the world velocity of q^d's path plus a pull of 1/s toward it, at most
-  // `speed` of the box (scaled as a vector, so the direction holds), the heading error closed at
-  // 2/s; every step within the base's accelerations, as the rollouts will clamp it.
+  // The steering law: the world velocity and turn rate of q^d's path plus a pull of 2/s toward
+  // where q^d is at the same step (position and heading), at most `speed` of the box (scaled as a
+  // vector, so the direction holds); every step within the base's accelerations, as the rollouts
+  // will clamp it. (Pulling toward q^d one step later ran the law a step ahead of a walking
+  // person and its half-speed copy behind; the two tied ~5 cm behind and took turns.)
   auto steer = [&](size_t lane, double speed) {
     Pose2 p = in.robot;
     Twist prev = in.current;
@@ -122,8 +124,8 @@ void Mppi::prepare_guide_block(const MppiInputs& in) {
     for (size_t k = 0; k < horizon; ++k) {
       const GoalFrame& g0 = goal_frames_[std::min(k, goal_frames_.size() - 1)];
       const GoalFrame& g1 = goal_frames_[std::min(k + 1, goal_frames_.size() - 1)];
-      const double wx = (g1.x - g0.x) / dt + (g1.x - p.x_m);
-      const double wy = (g1.y - g0.y) / dt + (g1.y - p.y_m);
+      const double wx = (g1.x - g0.x) / dt + 2.0 * (g0.x - p.x_m);
+      const double wy = (g1.y - g0.y) / dt + 2.0 * (g0.y - p.y_m);
       const double c = std::cos(p.theta_rad);
       const double s = std::sin(p.theta_rad);
       double bx = c * wx + s * wy;
@@ -132,7 +134,9 @@ void Mppi::prepare_guide_block(const MppiInputs& in) {
           {1.0, box.vx / std::max(std::abs(bx), 1e-9), box.vy / std::max(std::abs(by), 1e-9)});
       bx *= scale;
       by *= scale;
-      const double bw = std::clamp(2.0 * wrap_angle(g1.theta - p.theta_rad), -box.wz, box.wz);
+      const double bw = std::clamp(
+          wrap_angle(g1.theta - g0.theta) / dt + 2.0 * wrap_angle(g0.theta - p.theta_rad), -box.wz,
+          box.wz);
       const Twist u{toward(prev.vx, bx, dv), toward(prev.vy, by, dv), toward(prev.wz, bw, dw)};
       put(lane, k, u);
       p = Pose2{p.x_m + (u.vx * c - u.vy * s) * dt, p.y_m + (u.vx * s + u.vy * c) * dt,
