@@ -98,7 +98,7 @@ void RunMetricsRecorder::record(double t_s, double dt_s, const core::Pose2& robo
     dist_time_ += dt_s;
     m_.side_time_s[static_cast<size_t>(sector_of(std::atan2(rel.y_m, rel.x_m)))] += dt_s;
     if (view.has_goal) {
-      const core::Pose2 e = view.robot_odom.inverse() * view.goal_odom;
+      const core::Pose2 e = robot.inverse() * (person * view.goal_in_person);
       ex2_ += e.x_m * e.x_m * dt_s;
       ey2_ += e.y_m * e.y_m * dt_s;
       eth2_ += e.theta_rad * e.theta_rad * dt_s;
@@ -135,7 +135,8 @@ void RunMetricsRecorder::record(double t_s, double dt_s, const core::Pose2& robo
     s.person = person;
     s.pedestrians = pedestrians;
     s.has_goal = view.has_goal;
-    s.goal = {view.goal_world.x_m, view.goal_world.y_m};
+    const core::Pose2 goal = person * view.goal_in_person;
+    s.goal = {goal.x_m, goal.y_m};
     s.active = view.active;
     s.side = view.side;
     s.cmd_vx_mps = view.cmd_vx;

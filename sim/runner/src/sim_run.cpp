@@ -41,17 +41,14 @@ SimWorldConfig world_config(const firmware::DaemonConfig& cfg, uint32_t seed) {
   return w;
 }
 
-DaemonView daemon_view(const firmware::Daemon& daemon, const core::Pose2& robot_world) {
+DaemonView daemon_view(const firmware::Daemon& daemon) {
   DaemonView v;
   const auto s = daemon.safety().read();
   v.active = s && s->value.state == core::SafetyState::kActive;
-  const auto b = daemon.base_health().read();
-  if (b) v.robot_odom = b->value.odom;
   const auto g = daemon.goal().read();
   if (g && g->value.status == core::GoalStatus::kOk) {
     v.has_goal = true;
-    v.goal_odom = g->value.goal_odom;
-    v.goal_world = robot_world * (v.robot_odom.inverse() * v.goal_odom);
+    v.goal_in_person = g->value.person_odom.inverse() * g->value.goal_odom;
     v.side = firmware::side_sector(g->value.index, g->value.points);
   }
   if (const auto c = daemon.command().read()) {
@@ -176,10 +173,10 @@ SimRunResult run_simulation(const SimRunOptions& o) {
                      }
                      world.step(tick.now);
                      const core::Pose2 robot = world.robot_pose();
-                     recorder.record(
-                         t_s, step_s, robot, world.person_pose(), world.pedestrian_positions(),
-                         world.footprint_clearance_static(), world.footprint_clearance_people(),
-                         daemon_view(daemon, robot));
+                     recorder.record(t_s, step_s, robot, world.person_pose(),
+                                     world.pedestrian_positions(),
+                                     world.footprint_clearance_static(),
+                                     world.footprint_clearance_people(), daemon_view(daemon));
                      while (auto f = sniffer->receive()) {
                        if (o.capture_can) result.can_out.push_back(f->frame);
                      }

@@ -38,7 +38,7 @@ void WorldThread::run(hal::Nanos origin, const firmware::Daemon& daemon) {
     const core::Pose2 person = world_.person_pose();
     recorder_.record(world_.time_s(), step_s, robot, person, world_.pedestrian_positions(),
                      world_.footprint_clearance_static(), world_.footprint_clearance_people(),
-                     daemon_view(daemon, robot));
+                     daemon_view(daemon));
     t_s_.store(world_.time_s(), std::memory_order_relaxed);
     distance_m_.store(std::hypot(robot.x_m - person.x_m, robot.y_m - person.y_m),
                       std::memory_order_relaxed);

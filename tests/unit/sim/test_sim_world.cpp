@@ -564,19 +564,29 @@ TEST(RunMetrics, UncomfortableTimeFarFailureAndCollision) {
   EXPECT_STREQ(sim::to_string(sim::FailureKind::kHitPerson), "hit person");
 }
 
-TEST(RunMetrics, TrackingErrorIsInTheRobotFrame) {
-  sim::RunMetricsRecorder r;
+// e = q^d - q^r in the robot frame, q^d the chosen point of W carried with the true person: a
+// person who walks on moves q^d with them (the old metric kept q^d where the last selection
+// put it, in the daemon's odometry).
+TEST(RunMetrics, TrackingErrorIsTheChosenPointOnThePersonNowInTheRobotFrame) {
   sim::DaemonView v;
   v.active = true;
   v.has_goal = true;
-  v.robot_odom = Pose2{1, 1, std::numbers::pi / 2};
-  v.goal_odom = Pose2{1, 1.3, std::numbers::pi / 2 + 0.1};  // 0.3 m ahead of the robot
-  for (int i = 0; i < 10; ++i)
-    r.record(0.01 * i, 0.01, Pose2{}, Pose2{5, 0, 0}, {}, 5.0, 5.0, v);
+  v.goal_in_person = Pose2{-1.0, 0.0, 0.1};  // 1 m behind them, turned 0.1 rad left
+  const Pose2 robot{1, 1, std::numbers::pi / 2};
+  sim::RunMetricsRecorder r;
+  for (int i = 0; i < 10; ++i)  // q^d 0.3 m ahead of the robot
+    r.record(0.01 * i, 0.01, robot, Pose2{1, 2.3, std::numbers::pi / 2}, {}, 5.0, 5.0, v);
   const auto m = r.finish();
   EXPECT_NEAR(m.rmse_ex_m, 0.3, 1e-9);
   EXPECT_NEAR(m.rmse_ey_m, 0.0, 1e-9);
   EXPECT_NEAR(m.rmse_etheta_rad, 0.1, 1e-9);
+  ASSERT_FALSE(r.samples().empty());
+  EXPECT_NEAR(r.samples().front().goal.y_m, 1.3, 1e-9);
+
+  sim::RunMetricsRecorder walked;  // the person 0.2 m further on, the same choice
+  for (int i = 0; i < 10; ++i)
+    walked.record(0.01 * i, 0.01, robot, Pose2{1, 2.5, std::numbers::pi / 2}, {}, 5.0, 5.0, v);
+  EXPECT_NEAR(walked.finish().rmse_ex_m, 0.5, 1e-9);
 }
 
 TEST(RunMetrics, SectorsNameTheSidesOfThePerson) {

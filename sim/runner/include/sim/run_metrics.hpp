@@ -5,7 +5,9 @@
 //  - UT: seconds with the robot centre closer than 0.45 m to the person (Hall's intimate zone);
 //    also the seconds inside the CBF ellipse (h < 0);
 //  - tracking error e = q^d - q^r in the robot frame, RMSE of e_x, e_y, e_theta (wrapped), over
-//    the time the supervisor lets the robot move toward a chosen point;
+//    the time the supervisor lets the robot move toward a chosen point; q^r the true robot, q^d
+//    the chosen point of the person's W on the true person now (so the person's estimate, the
+//    odometry's age and the 30 Hz selection's age all count; the daemon's own frame hid them);
 //  - minimum clearances, the side distribution of the robot around the person (8 sectors of
 //    the person's frame: 0 = front, 2 = left, 4 = behind, 6 = right), command jerk.
 // Fed once per world step with the truth and what the daemon decided.
@@ -24,7 +26,7 @@ struct RunSample {  // for pictures: every 100 ms
   core::Pose2 person;  // world
   std::vector<core::Point2> pedestrians;
   bool has_goal = false;
-  core::Point2 goal;  // q^d in the world
+  core::Point2 goal;  // q^d in the world (the chosen point of W on the true person)
   bool active = false;
   int side = -1;                          // sector of the chosen point (0..7), -1 none
   double cmd_vx_mps = 0, cmd_vy_mps = 0;  // the daemon's last command, base_link
@@ -71,9 +73,10 @@ struct MetricsConfig {
 struct DaemonView {
   bool active = false;
   bool has_goal = false;
-  core::Pose2 goal_odom;
-  core::Pose2 robot_odom;  // the daemon's own odometry, the frame of goal_odom
-  core::Pose2 goal_world;
+  // q^d in the frame of the person it was chosen around (a point of their interactive space W):
+  // where it is now is that point carried with the person, whatever the daemon's odometry
+  // and the age of its last selection.
+  core::Pose2 goal_in_person;
   int side = -1;
   double cmd_vx = 0, cmd_vy = 0;
   bool tracking = false;  // the controller ran on q^d: plan_* hold its best rollout's terms

@@ -22,8 +22,8 @@ namespace sim {
 // robot's footprint and limits), taken from it.
 SimWorldConfig world_config(const firmware::DaemonConfig& cfg, uint32_t seed);
 
-// What the daemon decided, read from its channels, with the goal placed in the world.
-DaemonView daemon_view(const firmware::Daemon& daemon, const core::Pose2& robot_world);
+// What the daemon decided, read from its channels (q^d as the point of the person's W it chose).
+DaemonView daemon_view(const firmware::Daemon& daemon);
 
 struct SimRunOptions {
   firmware::DaemonConfig config;
