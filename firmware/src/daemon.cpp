@@ -29,8 +29,8 @@ constexpr double kMaxOdomLagS = 0.1;
 constexpr Nanos kBaseReaction = std::chrono::milliseconds(150);
 
 // The base's measured velocity, which carries its odometry on to a later time.
-core::BodyRate body_rate(const BaseHealth& b) {
-  return core::BodyRate{b.vx_mps, b.vy_mps, b.wz_radps};
+core::BodyVelocity measured_velocity(const BaseHealth& b) {
+  return core::BodyVelocity{b.vx_mps, b.vy_mps, b.wz_radps};
 }
 }  // namespace
 
@@ -298,7 +298,7 @@ void Daemon::tracker_task(const core::Tick& tick) {
 
   // Where the robot was when each frame arrived (wheel odometry; identity without a base).
   if (const auto b = base_health_.read(); b && b->value.odom_stamp != core::kNever) {
-    odom_history_.add(b->value.odom, b->value.odom_stamp, body_rate(b->value));
+    odom_history_.add(b->value.odom, b->value.odom_stamp, measured_velocity(b->value));
   }
   for (const amfitrack::StampedMeasurement& sm : tracker_->new_measurements()) {
     const auto person = person_frame_.to_base(sm.m);
@@ -390,7 +390,7 @@ void Daemon::attach_lidar(std::unique_ptr<hal::DatagramSource> data) {
 void Daemon::lidar_task(const core::Tick& tick) {
   if (!lidar_) return;
   if (const auto b = base_health_.read(); b && b->value.odom_stamp != core::kNever) {
-    lidar_odom_.add(b->value.odom, b->value.odom_stamp, body_rate(b->value));
+    lidar_odom_.add(b->value.odom, b->value.odom_stamp, measured_velocity(b->value));
   }
   std::optional<core::HumanTrack> person;
   if (const auto h = human_track_.read(); h && h->value.valid) person = h->value;
@@ -570,7 +570,7 @@ bool Daemon::run_controller(Nanos now, core::BodyVelocity& requested) {
   // every 20 ms; at 1 m/s that is 2 cm of lag otherwise).
   const BaseHealth& b = base->value;
   const double lag_s = std::clamp(core::to_seconds(now - b.odom_stamp), 0.0, kMaxOdomLagS);
-  const core::Pose2 robot = core::carried(b.odom, body_rate(b), lag_s);
+  const core::Pose2 robot = core::carried(b.odom, measured_velocity(b), lag_s);
   // The person for the barrier: constant velocity, the conservative prediction of where they
   // may be. q^d, the point to be at, walks with them on a velocity that fades with
   // human.prediction_time_constant_s (2 s by default), so it stays on the costmap; at constant
@@ -578,7 +578,7 @@ bool Daemon::run_controller(Nanos now, core::BodyVelocity& requested) {
   // q^d's turn rate fades with human.prediction_turn_time_constant_s when set (0: as the
   // velocity); the barrier's person keeps a constant turn rate.
   // q^d is a point of the person's interactive space: it walks with them over the horizon.
-  const core::Pose2 goal_in_person = goal->value.person_odom.inverse() * goal->value.goal_odom;
+  const core::Pose2 goal_in_person = goal->value.goal_in_person();
   core::predict_person_and_goal_paths(track->value, now, mppi_.config().step_s, human_config_,
                                       goal_in_person, person_path_, goal_path_);
   const auto map = costmap_.latest();

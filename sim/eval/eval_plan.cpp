@@ -126,8 +126,7 @@ std::optional<std::vector<Case>> expand_cases(const std::string& name, int rando
   error = fmt::format(
       "unknown case '{}': a scenario (open, static_obstacle, pedestrian_front_right, corridor, "
       "doorway, crossing, random, dead_end), a group (paper, crowds, speeds, sizes, constrained), "
-      "or "
-      "crowd-N, speed-V, size-AxB, clutter-C",
+      "or crowd-N, speed-V, size-AxB, clutter-C",
       name);
   return std::nullopt;
 }

@@ -2,8 +2,8 @@
 
 namespace core {
 
-Pose2 carried(const Pose2& pose, const BodyRate& rate, double dt_s) {
-  return pose * Pose2{rate.vx_mps * dt_s, rate.vy_mps * dt_s, rate.wz_radps * dt_s};
+Pose2 carried(const Pose2& pose, const BodyVelocity& velocity, double dt_s) {
+  return pose * Pose2{velocity.vx_mps * dt_s, velocity.vy_mps * dt_s, velocity.wz_radps * dt_s};
 }
 
 PoseHistory::PoseHistory(size_t capacity, Nanos max_extrapolation)
@@ -13,9 +13,9 @@ const PoseHistory::Entry& PoseHistory::entry(size_t i) const {
   return ring_[(head_ + ring_.size() - size_ + i) % ring_.size()];
 }
 
-bool PoseHistory::add(const Pose2& pose, Nanos stamp, const BodyRate& rate) {
+bool PoseHistory::add(const Pose2& pose, Nanos stamp, const BodyVelocity& velocity) {
   if (size_ > 0 && stamp <= entry(size_ - 1).stamp) return false;
-  ring_[head_] = Entry{pose, stamp, rate};
+  ring_[head_] = Entry{pose, stamp, velocity};
   head_ = (head_ + 1) % ring_.size();
   if (size_ < ring_.size()) ++size_;
   return true;
@@ -31,7 +31,7 @@ std::optional<Pose2> PoseHistory::at(Nanos t) const {
   const Entry& newest = entry(size_ - 1);
   if (t >= newest.stamp) {
     if (t - newest.stamp > max_extrapolation_) return std::nullopt;
-    return carried(newest.pose, newest.rate, to_seconds(t - newest.stamp));
+    return carried(newest.pose, newest.velocity, to_seconds(t - newest.stamp));
   }
   if (t < entry(0).stamp) return std::nullopt;
   // Binary search for the first entry after t.

@@ -102,6 +102,9 @@ struct CompanionGoal {
   // Static text: "objective", "policy", "fixed_behind", "fixed_side" (policy.selector).
   const char* selector = "objective";
   bool held = false;  // no free point: the last choice kept (policy.hold_last_point_ms)
+  // q^d in the frame of the person it was chosen around: a point of their W, which moves with
+  // them (the controller carries it along their predicted path).
+  [[nodiscard]] core::Pose2 goal_in_person() const { return person_odom.inverse() * goal_odom; }
 };
 // What the control task publishes: how the controller did on its latest run.
 struct ControlStatus {

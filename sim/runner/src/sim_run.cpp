@@ -48,7 +48,7 @@ DaemonView daemon_view(const firmware::Daemon& daemon) {
   const auto g = daemon.goal().read();
   if (g && g->value.status == core::GoalStatus::kOk) {
     v.has_goal = true;
-    v.goal_in_person = g->value.person_odom.inverse() * g->value.goal_odom;
+    v.goal_in_person = g->value.goal_in_person();
     v.side = firmware::side_sector(g->value.index, g->value.points);
   }
   if (const auto c = daemon.command().read()) {

@@ -6,18 +6,14 @@
 #include <optional>
 #include <vector>
 
+#include "core/geometry/body_velocity.hpp"
 #include "core/geometry/pose2.hpp"
 #include "core/time.hpp"
 
 namespace core {
 
-// A body's velocity in its own frame (base_link: forward, left, counter-clockwise).
-struct BodyRate {
-  double vx_mps = 0.0, vy_mps = 0.0, wz_radps = 0.0;
-};
-
-// `pose` moved on for `dt_s` at `rate` (first order: the base's odometry comes every 20 ms).
-[[nodiscard]] Pose2 carried(const Pose2& pose, const BodyRate& rate, double dt_s);
+// `pose` moved on for `dt_s` at `velocity` (first order: the base's odometry comes every 20 ms).
+[[nodiscard]] Pose2 carried(const Pose2& pose, const BodyVelocity& velocity, double dt_s);
 
 class PoseHistory {
  public:
@@ -26,9 +22,9 @@ class PoseHistory {
   // tracker frames are newer than the newest odometry); beyond it, no answer.
   PoseHistory(size_t capacity, Nanos max_extrapolation);
 
-  // Stamps must increase; an older or equal stamp is ignored (returns false). `rate`: the
-  // body's velocity at `pose` (zero: a newer query holds the pose).
-  bool add(const Pose2& pose, Nanos stamp, const BodyRate& rate = {});
+  // Stamps must increase; an older or equal stamp is ignored (returns false). `velocity`: the
+  // body's at `pose` (zero: a newer query holds the pose).
+  bool add(const Pose2& pose, Nanos stamp, const BodyVelocity& velocity = {});
   // Interpolated pose at `t`; nullopt when `t` is before the oldest pose kept, too far past the
   // newest, or the history is empty.
   [[nodiscard]] std::optional<Pose2> at(Nanos t) const;
@@ -39,7 +35,7 @@ class PoseHistory {
   struct Entry {
     Pose2 pose;
     Nanos stamp{0};
-    BodyRate rate;
+    BodyVelocity velocity;
   };
   [[nodiscard]] const Entry& entry(size_t i) const;  // 0 = oldest
 

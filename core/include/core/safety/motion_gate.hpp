@@ -5,16 +5,10 @@
 // no later than `max_stop_time` after motion stopped being allowed.
 #include <cstdint>
 
+#include "core/geometry/body_velocity.hpp"
 #include "core/time.hpp"
 
 namespace core {
-
-struct BodyVelocity {
-  double vx_mps = 0.0;    // forward
-  double vy_mps = 0.0;    // left
-  double wz_radps = 0.0;  // counter-clockwise
-  [[nodiscard]] bool is_zero() const { return vx_mps == 0.0 && vy_mps == 0.0 && wz_radps == 0.0; }
-};
 
 struct StopLimits {
   double linear_decel_mps2 = 1.5;
