@@ -1,0 +1,429 @@
+// The only translation unit with <torch/torch.h> besides the trainer's tests (each costs ~20 s
+// and ~1.2 GB to compile).
+#include "sim/training/ppo.hpp"
+
+#include <torch/torch.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <random>
+#include <stdexcept>
+
+namespace sim::training {
+namespace {
+
+// A ReLU MLP; the last layer has no activation.
+struct MlpImpl : torch::nn::Module {
+  MlpImpl(int64_t in, const std::vector<int>& hidden, int64_t out, double last_gain) {
+    int64_t prev = in;
+    for (size_t i = 0; i <= hidden.size(); ++i) {
+      const int64_t width = i < hidden.size() ? hidden[i] : out;
+      layers.push_back(register_module("fc" + std::to_string(i), torch::nn::Linear(prev, width)));
+      prev = width;
+    }
+    // A near-uniform first policy (and a near-zero first value): the usual PPO initialisation.
+    torch::NoGradGuard no_grad;
+    layers.back()->weight.mul_(last_gain);
+    layers.back()->bias.zero_();
+  }
+  torch::Tensor forward(torch::Tensor x) {
+    for (size_t i = 0; i + 1 < layers.size(); ++i)
+      x = torch::relu(layers[i]->forward(x));
+    return layers.back()->forward(x);
+  }
+  std::vector<torch::nn::Linear> layers;
+};
+TORCH_MODULE(Mlp);
+
+// Running mean and variance of the observations (Chan et al.'s parallel update), like skrl's
+// RunningStandardScaler; frozen into the exported file.
+struct Standardiser {
+  explicit Standardiser(size_t width) : mean(width, 0.0), m2(width, 0.0) {}
+  void add(const float* rows, size_t count, size_t width) {
+    if (count == 0) return;
+    std::vector<double> bm(width, 0.0), bv(width, 0.0);
+    for (size_t r = 0; r < count; ++r)
+      for (size_t j = 0; j < width; ++j)
+        bm[j] += static_cast<double>(rows[r * width + j]);
+    for (double& v : bm)
+      v /= static_cast<double>(count);
+    for (size_t r = 0; r < count; ++r) {
+      for (size_t j = 0; j < width; ++j) {
+        const double d = static_cast<double>(rows[r * width + j]) - bm[j];
+        bv[j] += d * d;
+      }
+    }
+    const double na = n, nb = static_cast<double>(count), total = na + nb;
+    for (size_t j = 0; j < width; ++j) {
+      const double delta = bm[j] - mean[j];
+      mean[j] += delta * nb / total;
+      m2[j] += bv[j] + delta * delta * na * nb / total;
+    }
+    n = total;
+  }
+  [[nodiscard]] double stddev(size_t j, double floor) const {
+    return n > 1 ? std::max(std::sqrt(m2[j] / n), floor) : 1.0;
+  }
+  double n = 0;
+  std::vector<double> mean, m2;
+};
+
+}  // namespace
+
+void compute_gae(std::span<const float> rewards, std::span<const float> values,
+                 std::span<const uint8_t> done, std::span<const float> last_values, int steps,
+                 int envs, double discount, double lambda, std::span<float> advantages,
+                 std::span<float> returns) {
+  for (int e = 0; e < envs; ++e) {
+    double gae = 0;
+    for (int t = steps - 1; t >= 0; --t) {
+      const size_t i = static_cast<size_t>(t) * static_cast<size_t>(envs) + static_cast<size_t>(e);
+      const double next_value =
+          static_cast<double>(t == steps - 1 ? last_values[static_cast<size_t>(e)]
+                                             : values[i + static_cast<size_t>(envs)]);
+      const double not_done = done[i] != 0 ? 0.0 : 1.0;
+      const double value = static_cast<double>(values[i]);
+      const double delta =
+          static_cast<double>(rewards[i]) + discount * next_value * not_done - value;
+      gae = delta + discount * lambda * not_done * gae;
+      advantages[i] = static_cast<float>(gae);
+      returns[i] = static_cast<float>(gae + value);
+    }
+  }
+}
+
+struct PpoTrainer::Impl {
+  Impl(const PpoConfig& c, std::vector<Environment*> e)
+      : config(c),
+        envs(std::move(e)),
+        obs_size(envs.front()->observation_size()),
+        actions(envs.front()->actions()),
+        actor(static_cast<int64_t>(obs_size), c.hidden, actions, 0.01),
+        critic(static_cast<int64_t>(obs_size), c.hidden, 1, 1.0),
+        scaler(obs_size),
+        rng(c.seed) {
+    for (Environment* env : envs) {
+      if (env->observation_size() != obs_size || env->actions() != actions) {
+        throw std::invalid_argument("environments differ in observation or action size");
+      }
+    }
+    std::vector<torch::Tensor> params = actor->parameters();
+    for (const auto& p : critic->parameters())
+      params.push_back(p);
+    optimizer = std::make_unique<torch::optim::Adam>(
+        params, torch::optim::AdamOptions(config.learning_rate));
+    lr = config.learning_rate;
+    const size_t n = envs.size();
+    obs.assign(n * obs_size, 0.0f);
+    mask.assign(n * static_cast<size_t>(actions), 0);
+    for (size_t i = 0; i < n; ++i)
+      reset_env(i);
+  }
+
+  void reset_env(size_t i) {
+    envs[i]->reset(std::span<float>(&obs[i * obs_size], obs_size), mask_of(i));
+  }
+  std::span<bool> mask_of(size_t i) {
+    return {reinterpret_cast<bool*>(&mask[i * static_cast<size_t>(actions)]),
+            static_cast<size_t>(actions)};
+  }
+
+  // Standardised observations of `rows` raw rows as a tensor.
+  torch::Tensor standardise(const float* raw, size_t rows) const {
+    auto x = torch::from_blob(const_cast<float*>(raw),
+                              {static_cast<int64_t>(rows), static_cast<int64_t>(obs_size)},
+                              torch::kFloat32)
+                 .clone();
+    std::vector<float> m(obs_size), s(obs_size);
+    for (size_t j = 0; j < obs_size; ++j) {
+      m[j] = static_cast<float>(scaler.n > 0 ? scaler.mean[j] : 0.0);
+      s[j] = static_cast<float>(scaler.stddev(j, config.std_floor));
+    }
+    const auto mt = torch::from_blob(m.data(), {static_cast<int64_t>(obs_size)}, torch::kFloat32);
+    const auto st = torch::from_blob(s.data(), {static_cast<int64_t>(obs_size)}, torch::kFloat32);
+    return (x - mt) / st;
+  }
+  torch::Tensor mask_tensor(const uint8_t* m, size_t rows) const {
+    return torch::from_blob(const_cast<uint8_t*>(m),
+                            {static_cast<int64_t>(rows), static_cast<int64_t>(actions)},
+                            torch::kUInt8)
+        .to(torch::kBool)
+        .clone();
+  }
+  static torch::Tensor masked(const torch::Tensor& logits, const torch::Tensor& m) {
+    // A row with no allowed action keeps every logit (the environment falls back on its own).
+    const auto any = m.any(1, true);
+    const auto allowed = torch::logical_or(m, torch::logical_not(any));
+    return logits.masked_fill(torch::logical_not(allowed), -1e9);
+  }
+
+  int sample(const float* probs) {
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    double r = u(rng), acc = 0;
+    for (int a = 0; a < actions; ++a) {
+      acc += static_cast<double>(probs[a]);
+      if (r <= acc) return a;
+    }
+    for (int a = actions - 1; a >= 0; --a)
+      if (probs[a] > 0) return a;
+    return 0;
+  }
+
+  PpoConfig config;
+  std::vector<Environment*> envs;
+  size_t obs_size;
+  int actions;
+  Mlp actor, critic;
+  Standardiser scaler;
+  std::unique_ptr<torch::optim::Adam> optimizer;
+  double lr;
+  std::mt19937_64 rng;
+  std::vector<float> obs;     // current raw observation per environment
+  std::vector<uint8_t> mask;  // current mask per environment
+  uint64_t env_steps = 0;
+};
+
+PpoTrainer::PpoTrainer(const PpoConfig& config, std::vector<Environment*> envs) {
+  if (envs.empty()) throw std::invalid_argument("PPO needs at least one environment");
+  torch::set_num_threads(1);
+  torch::manual_seed(config.seed);
+  impl_ = std::make_unique<Impl>(config, std::move(envs));
+  // Start the standardiser on the first observations.
+  impl_->scaler.add(impl_->obs.data(), impl_->envs.size(), impl_->obs_size);
+}
+
+PpoTrainer::~PpoTrainer() = default;
+
+UpdateStats PpoTrainer::update() {
+  Impl& m = *impl_;
+  const int T = m.config.rollout_steps;
+  const int N = static_cast<int>(m.envs.size());
+  const size_t rows = static_cast<size_t>(T) * static_cast<size_t>(N);
+  const size_t A = static_cast<size_t>(m.actions);
+  std::vector<float> raw(rows * m.obs_size);
+  std::vector<uint8_t> masks(rows * A);
+  std::vector<int64_t> acts(rows);
+  std::vector<float> logp(rows), values(rows), rewards(rows), last_values(static_cast<size_t>(N));
+  std::vector<uint8_t> done(rows);
+  torch::Tensor obs_t;
+  double reward_sum = 0;
+  {
+    torch::NoGradGuard no_grad;
+    for (int t = 0; t < T; ++t) {
+      const size_t base = static_cast<size_t>(t) * static_cast<size_t>(N);
+      std::copy(m.obs.begin(), m.obs.end(),
+                raw.begin() + static_cast<ptrdiff_t>(base * m.obs_size));
+      std::copy(m.mask.begin(), m.mask.end(), masks.begin() + static_cast<ptrdiff_t>(base * A));
+      const auto x = m.standardise(m.obs.data(), static_cast<size_t>(N));
+      const auto logits =
+          Impl::masked(m.actor->forward(x), m.mask_tensor(m.mask.data(), static_cast<size_t>(N)));
+      const auto lp = torch::log_softmax(logits, 1).contiguous();
+      const auto probs = lp.exp().contiguous();
+      const auto v = m.critic->forward(x).squeeze(1).contiguous();
+      for (int e = 0; e < N; ++e) {
+        const size_t i = base + static_cast<size_t>(e);
+        const int a = m.sample(probs.data_ptr<float>() + static_cast<size_t>(e) * A);
+        acts[i] = a;
+        logp[i] = lp.data_ptr<float>()[static_cast<size_t>(e) * A + static_cast<size_t>(a)];
+        values[i] = v.data_ptr<float>()[e];
+        const auto out = m.envs[static_cast<size_t>(e)]->step(
+            a, std::span<float>(&m.obs[static_cast<size_t>(e) * m.obs_size], m.obs_size),
+            m.mask_of(static_cast<size_t>(e)));
+        rewards[i] = static_cast<float>(out.reward * m.config.reward_scale);
+        reward_sum += out.reward;
+        done[i] = (out.terminated || out.truncated) ? 1 : 0;
+      }
+    }
+    const auto x = m.standardise(m.obs.data(), static_cast<size_t>(N));
+    const auto v = m.critic->forward(x).squeeze(1).contiguous();
+    std::copy(v.data_ptr<float>(), v.data_ptr<float>() + N, last_values.begin());
+  }
+  m.env_steps += rows;
+
+  std::vector<float> adv(rows), ret(rows);
+  compute_gae(rewards, values, done, last_values, T, N, m.config.discount, m.config.gae_lambda, adv,
+              ret);
+  // Normalised advantages over the rollout.
+  const double mean = std::accumulate(adv.begin(), adv.end(), 0.0) / static_cast<double>(rows);
+  double var = 0;
+  for (float a : adv)
+    var += (static_cast<double>(a) - mean) * (static_cast<double>(a) - mean);
+  const double sd = std::sqrt(var / static_cast<double>(rows)) + 1e-8;
+  for (float& a : adv)
+    a = static_cast<float>((static_cast<double>(a) - mean) / sd);
+
+  const auto X = m.standardise(raw.data(), rows);
+  const auto M = m.mask_tensor(masks.data(), rows);
+  const auto act_t =
+      torch::from_blob(acts.data(), {static_cast<int64_t>(rows)}, torch::kInt64).clone();
+  const auto old_logp =
+      torch::from_blob(logp.data(), {static_cast<int64_t>(rows)}, torch::kFloat32).clone();
+  const auto adv_t =
+      torch::from_blob(adv.data(), {static_cast<int64_t>(rows)}, torch::kFloat32).clone();
+  const auto ret_t =
+      torch::from_blob(ret.data(), {static_cast<int64_t>(rows)}, torch::kFloat32).clone();
+
+  UpdateStats stats;
+  const int64_t batch = static_cast<int64_t>(rows) / m.config.minibatches;
+  std::vector<torch::Tensor> params = m.actor->parameters();
+  for (const auto& p : m.critic->parameters())
+    params.push_back(p);
+  std::vector<int64_t> order(rows);
+  for (int epoch = 0; epoch < m.config.epochs; ++epoch) {
+    std::iota(order.begin(), order.end(), 0);
+    std::shuffle(order.begin(), order.end(), m.rng);
+    double kl_sum = 0;
+    int kl_count = 0;
+    for (int b = 0; b < m.config.minibatches; ++b) {
+      const auto idx = torch::from_blob(order.data() + b * batch, {batch}, torch::kInt64).clone();
+      const auto x = X.index_select(0, idx);
+      const auto lp_all =
+          torch::log_softmax(Impl::masked(m.actor->forward(x), M.index_select(0, idx)), 1);
+      const auto a = act_t.index_select(0, idx);
+      const auto new_logp = lp_all.gather(1, a.unsqueeze(1)).squeeze(1);
+      const auto log_ratio = new_logp - old_logp.index_select(0, idx);
+      const auto ratio = log_ratio.exp();
+      const auto ad = adv_t.index_select(0, idx);
+      const auto surrogate = torch::min(
+          ratio * ad,
+          torch::clamp(ratio, 1.0 - m.config.ratio_clip, 1.0 + m.config.ratio_clip) * ad);
+      const auto policy_loss = -surrogate.mean();
+      const auto value = m.critic->forward(x).squeeze(1);
+      const auto value_loss =
+          m.config.value_loss_scale * torch::mse_loss(value, ret_t.index_select(0, idx));
+      auto loss = policy_loss + value_loss;
+      if (m.config.entropy_scale > 0) {
+        const auto p = lp_all.exp();
+        const auto entropy = -(p * lp_all.clamp_min(-1e8)).sum(1).mean();
+        loss = loss - m.config.entropy_scale * entropy;
+      }
+      m.optimizer->zero_grad();
+      loss.backward();
+      torch::nn::utils::clip_grad_norm_(params, m.config.grad_norm_clip);
+      m.optimizer->step();
+      {
+        torch::NoGradGuard no_grad;
+        kl_sum += ((ratio - 1) - log_ratio).mean().item<double>();
+        ++kl_count;
+      }
+      stats.policy_loss = policy_loss.item<double>();
+      stats.value_loss = value_loss.item<double>();
+    }
+    // skrl's KLAdaptiveLR, once per epoch on the epoch's mean KL.
+    const double kl = kl_sum / std::max(kl_count, 1);
+    stats.kl = kl;
+    if (kl > 2.0 * m.config.kl_target) {
+      m.lr = std::max(m.config.lr_min, m.lr / m.config.lr_factor);
+    } else if (kl > 0 && kl < 0.5 * m.config.kl_target) {
+      m.lr = std::min(m.config.lr_max, m.lr * m.config.lr_factor);
+    }
+    for (auto& group : m.optimizer->param_groups()) {
+      static_cast<torch::optim::AdamOptions&>(group.options()).lr(m.lr);
+    }
+  }
+  // The standardiser learns from this rollout for the next one (the rollout and its learning
+  // phase saw the same statistics).
+  m.scaler.add(raw.data(), rows, m.obs_size);
+  stats.env_steps = m.env_steps;
+  stats.learning_rate = m.lr;
+  stats.mean_reward = reward_sum / static_cast<double>(rows);
+  return stats;
+}
+
+double PpoTrainer::imitate(const std::function<int(size_t env)>& teacher, int rollouts) {
+  Impl& m = *impl_;
+  const size_t N = m.envs.size();
+  const size_t A = static_cast<size_t>(m.actions);
+  std::vector<float> raw;
+  std::vector<uint8_t> masks;
+  std::vector<int64_t> targets;
+  for (int r = 0; r < rollouts * m.config.rollout_steps; ++r) {
+    for (size_t e = 0; e < N; ++e) {
+      const int a = teacher(e);
+      if (a >= 0) {
+        raw.insert(raw.end(), m.obs.begin() + static_cast<ptrdiff_t>(e * m.obs_size),
+                   m.obs.begin() + static_cast<ptrdiff_t>((e + 1) * m.obs_size));
+        masks.insert(masks.end(), m.mask.begin() + static_cast<ptrdiff_t>(e * A),
+                     m.mask.begin() + static_cast<ptrdiff_t>((e + 1) * A));
+        targets.push_back(a);
+      }
+      m.envs[e]->step(a, std::span<float>(&m.obs[e * m.obs_size], m.obs_size), m.mask_of(e));
+    }
+  }
+  m.env_steps += static_cast<uint64_t>(rollouts * m.config.rollout_steps) * N;
+  const size_t rows = targets.size();
+  if (rows == 0) return 0.0;
+  m.scaler.add(raw.data(), rows, m.obs_size);
+  const auto X = m.standardise(raw.data(), rows);
+  const auto M = m.mask_tensor(masks.data(), rows);
+  const auto Y =
+      torch::from_blob(targets.data(), {static_cast<int64_t>(rows)}, torch::kInt64).clone();
+  torch::optim::Adam opt(m.actor->parameters(), torch::optim::AdamOptions(1e-3));
+  const int64_t batch = 256;
+  std::vector<int64_t> order(rows);
+  for (int epoch = 0; epoch < 20; ++epoch) {
+    std::iota(order.begin(), order.end(), 0);
+    std::shuffle(order.begin(), order.end(), m.rng);
+    for (int64_t s = 0; s < static_cast<int64_t>(rows); s += batch) {
+      const int64_t len = std::min<int64_t>(batch, static_cast<int64_t>(rows) - s);
+      const auto idx = torch::from_blob(order.data() + s, {len}, torch::kInt64).clone();
+      const auto logits =
+          Impl::masked(m.actor->forward(X.index_select(0, idx)), M.index_select(0, idx));
+      const auto loss = torch::nll_loss(torch::log_softmax(logits, 1), Y.index_select(0, idx));
+      opt.zero_grad();
+      loss.backward();
+      opt.step();
+    }
+  }
+  torch::NoGradGuard no_grad;
+  const auto pred = Impl::masked(m.actor->forward(X), M).argmax(1);
+  return pred.eq(Y).to(torch::kFloat32).mean().item<double>();
+}
+
+std::vector<float> PpoTrainer::logits(std::span<const float> observation) {
+  Impl& m = *impl_;
+  torch::NoGradGuard no_grad;
+  const auto l = m.actor->forward(m.standardise(observation.data(), 1)).contiguous();
+  return {l.data_ptr<float>(), l.data_ptr<float>() + m.actions};
+}
+
+int PpoTrainer::act_greedy(std::span<const float> observation, std::span<const bool> mask) {
+  const auto l = logits(observation);
+  int best = -1;
+  for (size_t a = 0; a < l.size() && a < mask.size(); ++a) {
+    if (mask[a] && (best < 0 || l[a] > l[static_cast<size_t>(best)])) best = static_cast<int>(a);
+  }
+  return best;
+}
+
+core::PolicyFile PpoTrainer::export_policy(uint32_t layout_id) const {
+  const Impl& m = *impl_;
+  core::PolicyFile f;
+  f.layout_id = layout_id;
+  f.points = static_cast<uint32_t>(m.actions);
+  f.mean.resize(static_cast<Eigen::Index>(m.obs_size));
+  f.stddev.resize(static_cast<Eigen::Index>(m.obs_size));
+  for (size_t j = 0; j < m.obs_size; ++j) {
+    f.mean[static_cast<Eigen::Index>(j)] =
+        static_cast<float>(m.scaler.n > 0 ? m.scaler.mean[j] : 0.0);
+    f.stddev[static_cast<Eigen::Index>(j)] =
+        static_cast<float>(m.scaler.stddev(j, m.config.std_floor));
+  }
+  for (size_t i = 0; i < m.actor->layers.size(); ++i) {
+    const auto& layer = m.actor->layers[i];
+    const auto w = layer->weight.detach().contiguous();
+    const auto b = layer->bias.detach().contiguous();
+    core::DenseLayer d;
+    d.weights.resize(w.size(0), w.size(1));
+    std::copy(w.data_ptr<float>(), w.data_ptr<float>() + w.numel(), d.weights.data());
+    d.bias.resize(b.size(0));
+    std::copy(b.data_ptr<float>(), b.data_ptr<float>() + b.numel(), d.bias.data());
+    d.activation =
+        i + 1 < m.actor->layers.size() ? core::Activation::kRelu : core::Activation::kNone;
+    f.layers.push_back(std::move(d));
+  }
+  return f;
+}
+
+}  // namespace sim::training

@@ -1,0 +1,187 @@
+// companion-train: PPO training of the learned selector in the training environment
+// (sim/training/follow_env.hpp), written as a policy file companiond reads (policy.file).
+// Optional build: cmake -DCOMPANION_BUILD_TRAINING=ON (needs libtorch-dev).
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <vector>
+
+#include "core/policy/observation.hpp"
+#include "firmware/config/config_loader.hpp"
+#include "sim/training/follow_env.hpp"
+#include "sim/training/ppo.hpp"
+
+namespace {
+
+using sim::training::FollowEnv;
+using sim::training::FollowEnvConfig;
+
+class FollowEnvironment final : public sim::training::Environment {
+ public:
+  FollowEnvironment(const FollowEnvConfig& c, uint64_t seed) : env(c, seed) {}
+  [[nodiscard]] size_t observation_size() const override { return env.observation_size(); }
+  [[nodiscard]] int actions() const override { return env.points(); }
+  void reset(std::span<float> o, std::span<bool> m) override { env.reset(o, m); }
+  Outcome step(int a, std::span<float> o, std::span<bool> m) override {
+    const auto r = env.step(a, o, m);
+    return {r.rewards.total(), r.terminated, r.truncated};
+  }
+  FollowEnv env;
+};
+
+struct EvalResult {
+  double mean_return = 0;
+  double contact_rate = 0, lost_rate = 0;
+  double near_obstacle_s = 0;  // per episode
+};
+
+// `episodes` whole episodes on fixed seeds (the same worlds for every call), choosing with
+// `choose` (an index into W, or -1).
+template <typename Choose>
+EvalResult evaluate(const FollowEnvConfig& config, int episodes, uint64_t first_seed,
+                    Choose&& choose) {
+  EvalResult r;
+  for (int i = 0; i < episodes; ++i) {
+    FollowEnv env(config, first_seed + static_cast<uint64_t>(i));
+    std::vector<float> obs(env.observation_size());
+    std::vector<uint8_t> mask_bytes(static_cast<size_t>(env.points()));
+    std::span<bool> mask(reinterpret_cast<bool*>(mask_bytes.data()), mask_bytes.size());
+    env.reset(obs, mask);
+    while (env.episodes() == 1) {
+      const int a = choose(env, obs, mask);
+      const auto s = env.step(a, obs, mask);
+      if (s.terminated || s.truncated) break;
+    }
+    const auto& e = env.last_episode();
+    r.mean_return += e.return_sum / episodes;
+    r.contact_rate += (e.contact ? 1.0 : 0.0) / episodes;
+    r.lost_rate += (e.lost ? 1.0 : 0.0) / episodes;
+    r.near_obstacle_s += e.near_obstacle_s / episodes;
+  }
+  return r;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "companion-train: PPO for the learned selector (writes a policy file for policy.file)"};
+  std::string out, config_path, log_path;
+  uint64_t steps = 200000, seed = 1;
+  int envs = 8, imitate_rollouts = 0, eval_every = 25, eval_episodes = 8;
+  app.add_option("--out", out, "policy file to write (the best evaluation so far)")->required();
+  app.add_option("-c,--config", config_path,
+                 "daemon configuration: the interactive space, objective, limits and costmap")
+      ->check(CLI::ExistingFile);
+  app.add_option("--steps", steps, "environment steps (policy decisions) to train for");
+  app.add_option("--envs", envs, "environments per rollout")->check(CLI::Range(1, 256));
+  app.add_option("--seed", seed, "seed of the worlds and of the learner");
+  app.add_option("--imitate-rollouts", imitate_rollouts,
+                 "warm start: rollouts of the objective selector to imitate first (0: none, "
+                 "the paper's from-scratch PPO)");
+  app.add_option("--eval-every", eval_every, "updates between evaluations")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--eval-episodes", eval_episodes, "episodes per evaluation (fixed worlds)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--log", log_path, "CSV of the training (one row per evaluation)");
+  CLI11_PARSE(app, argc, argv);
+
+  const auto loaded = config_path.empty() ? firmware::load_default_config()
+                                          : firmware::load_config_file(config_path);
+  if (!loaded.ok()) {
+    for (const auto& e : loaded.errors)
+      std::fprintf(stderr, "%s\n", e.to_string().c_str());
+    return 2;
+  }
+  const FollowEnvConfig env_config = sim::training::follow_env_config(*loaded.config);
+
+  // Worlds: training seeds from 1 000 000 (the benchmark uses 1-50, validation 101-180);
+  // evaluation worlds from 9 000 000.
+  std::vector<std::unique_ptr<FollowEnvironment>> owned;
+  std::vector<sim::training::Environment*> list;
+  for (int i = 0; i < envs; ++i) {
+    owned.push_back(std::make_unique<FollowEnvironment>(
+        env_config, 1000000 + seed * 1000 + static_cast<uint64_t>(i)));
+    list.push_back(owned.back().get());
+  }
+  sim::training::PpoConfig ppo;
+  ppo.seed = seed;
+  sim::training::PpoTrainer trainer(ppo, list);
+  const uint64_t eval_seed = 9000000;
+
+  std::FILE* log = log_path.empty() ? nullptr : std::fopen(log_path.c_str(), "w");
+  if (!log_path.empty() && log == nullptr) {
+    std::fprintf(stderr, "cannot write %s\n", log_path.c_str());
+    return 2;
+  }
+  if (log != nullptr) {
+    std::fprintf(log,
+                 "update,env_steps,wall_s,learning_rate,kl,mean_reward,eval_return,"
+                 "eval_contact_rate,eval_lost_rate,eval_near_obstacle_s\n");
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  auto wall = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
+
+  const EvalResult baseline =
+      evaluate(env_config, eval_episodes, eval_seed,
+               [](FollowEnv& env, auto&, auto&) { return env.objective_action(); });
+  std::printf(
+      "objective selector on %d evaluation worlds: return %.0f, contact %.0f %%, lost %.0f %%, "
+      "near obstacles %.1f s\n",
+      eval_episodes, baseline.mean_return, 100 * baseline.contact_rate, 100 * baseline.lost_rate,
+      baseline.near_obstacle_s);
+  if (imitate_rollouts > 0) {
+    const double acc = trainer.imitate([&](size_t e) { return owned[e]->env.objective_action(); },
+                                       imitate_rollouts);
+    std::printf("imitation of the objective selector: %.1f %% of its choices (%.0f s)\n", 100 * acc,
+                wall());
+  }
+
+  auto greedy = [&](FollowEnv&, std::vector<float>& obs, std::span<bool> mask) {
+    return trainer.act_greedy(obs, mask);
+  };
+  double best = -1e300;
+  auto save = [&](double score, int update) {
+    if (score <= best) return;
+    best = score;
+    const auto bytes = core::encode_policy(trainer.export_policy(core::kObservationLayout));
+    std::ofstream f(out, std::ios::binary);
+    f.write(reinterpret_cast<const char*>(bytes.data()),
+            static_cast<std::streamsize>(bytes.size()));
+    std::printf("  wrote %s (update %d, evaluation return %.0f)\n", out.c_str(), update, score);
+  };
+
+  int update = 0;
+  uint64_t done_steps = 0;
+  while (done_steps < steps) {
+    const auto s = trainer.update();
+    done_steps = s.env_steps;
+    ++update;
+    if (update % eval_every == 0 || done_steps >= steps) {
+      const EvalResult r = evaluate(env_config, eval_episodes, eval_seed, greedy);
+      std::printf(
+          "update %5d  steps %8llu  %6.0f s  lr %.1e  kl %.4f  reward/step %7.2f  "
+          "eval return %7.0f (objective %.0f)  contact %3.0f %%  lost %3.0f %%\n",
+          update, static_cast<unsigned long long>(done_steps), wall(), s.learning_rate, s.kl,
+          s.mean_reward, r.mean_return, baseline.mean_return, 100 * r.contact_rate,
+          100 * r.lost_rate);
+      std::fflush(stdout);
+      if (log != nullptr) {
+        std::fprintf(log, "%d,%llu,%.1f,%.3g,%.5f,%.3f,%.1f,%.3f,%.3f,%.2f\n", update,
+                     static_cast<unsigned long long>(done_steps), wall(), s.learning_rate, s.kl,
+                     s.mean_reward, r.mean_return, r.contact_rate, r.lost_rate, r.near_obstacle_s);
+        std::fflush(log);
+      }
+      save(r.mean_return, update);
+    }
+  }
+  if (log != nullptr) std::fclose(log);
+  std::printf("done: %llu steps in %.0f s (%.0f steps/s)\n",
+              static_cast<unsigned long long>(done_steps), wall(),
+              static_cast<double>(done_steps) / wall());
+  return 0;
+}

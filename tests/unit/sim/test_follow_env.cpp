@@ -1,0 +1,211 @@
+// The PPO training environment: the paper's reward terms, the observation and mask the daemon's
+// policy task builds, the robot going to the chosen point, contacts and loss ending an episode.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "core/policy/observation.hpp"
+#include "firmware/config/config_loader.hpp"
+#include "sim/training/follow_env.hpp"
+
+using sim::training::FollowEnv;
+using sim::training::FollowEnvConfig;
+using sim::training::RewardConfig;
+using sim::training::step_rewards;
+using sim::training::wrapped_index_distance;
+
+namespace {
+
+FollowEnvConfig default_config() {
+  const auto loaded = firmware::load_default_config();
+  EXPECT_TRUE(loaded.ok());
+  return sim::training::follow_env_config(*loaded.config);
+}
+
+FollowEnvConfig open_world() {
+  FollowEnvConfig c = default_config();
+  c.pedestrians_max = 0;
+  c.obstacles_max = 0;
+  c.constrained_probability = 0;
+  c.episode_s = 12.0;
+  return c;
+}
+
+struct Buffers {
+  explicit Buffers(const FollowEnv& env)
+      : obs(env.observation_size()), mask_bytes(static_cast<size_t>(env.points())) {}
+  std::span<bool> mask() { return {reinterpret_cast<bool*>(mask_bytes.data()), mask_bytes.size()}; }
+  std::vector<float> obs;
+  std::vector<uint8_t> mask_bytes;
+};
+
+}  // namespace
+
+TEST(FollowEnvReward, IndexDistanceWrapsRoundTheEllipse) {
+  EXPECT_EQ(wrapped_index_distance(0, 63, 64), 1);
+  EXPECT_EQ(wrapped_index_distance(63, 0, 64), 1);
+  EXPECT_EQ(wrapped_index_distance(0, 32, 64), 32);
+  EXPECT_EQ(wrapped_index_distance(10, 20, 64), 10);
+  EXPECT_EQ(wrapped_index_distance(5, 5, 64), 0);
+}
+
+TEST(FollowEnvReward, ThePapersThreeTerms) {
+  RewardConfig c;
+  c.sigma_h_per_m = 100;
+  c.tracking_reward = 50;
+  c.tracking_distance_m = 0.75;
+  c.sigma_a_per_index = 0.5;
+  c.collision_reward = -200;
+  c.safety_clearance_m = 0.75;
+  // Farther than D: sigma_h times the distance closed (negative when it grew).
+  auto r = step_rewards(c, 1.50, 1.40, 3, 3, 64, 2.0, false);
+  EXPECT_NEAR(r.human, 10.0, 1e-9);
+  EXPECT_EQ(r.action, 0.0);
+  EXPECT_EQ(r.collision, 0.0);
+  r = step_rewards(c, 1.40, 1.50, 3, 3, 64, 2.0, false);
+  EXPECT_NEAR(r.human, -10.0, 1e-9);
+  // Within D: r_tracking.
+  r = step_rewards(c, 0.80, 0.70, 3, 3, 64, 2.0, false);
+  EXPECT_EQ(r.human, 50.0);
+  // A jump of 6 points round the ellipse (wrapped: 62 -> 4).
+  r = step_rewards(c, 1.0, 1.0, 4, 62, 64, 2.0, false);
+  EXPECT_NEAR(r.action, -3.0, 1e-9);
+  // No previous action: no smoothness term.
+  EXPECT_EQ(step_rewards(c, 1.0, 1.0, 4, -1, 64, 2.0, false).action, 0.0);
+  // Obstacle nearer than the clearance, or a contact: r_collision.
+  EXPECT_EQ(step_rewards(c, 1.0, 1.0, 4, 4, 64, 0.70, false).collision, -200.0);
+  EXPECT_EQ(step_rewards(c, 1.0, 1.0, 4, 4, 64, 0.80, false).collision, 0.0);
+  EXPECT_EQ(step_rewards(c, 1.0, 1.0, 4, 4, 64, 3.0, true).collision, -200.0);
+  EXPECT_NEAR(step_rewards(c, 1.5, 1.4, 4, 62, 64, 0.5, false).total(), 10 - 3 - 200, 1e-9);
+}
+
+TEST(FollowEnv, TakesItsNumbersFromTheDaemonConfiguration) {
+  const FollowEnvConfig c = default_config();
+  EXPECT_EQ(c.space.points, 64);
+  EXPECT_DOUBLE_EQ(c.space.cost_threshold, 30.0);
+  // The costmap reaches R = 30 at ~0.75 m from an obstacle (core/perception/costmap.hpp).
+  EXPECT_NEAR(c.reward.safety_clearance_m, 0.75, 0.01);
+  EXPECT_DOUBLE_EQ(c.max_vx_mps, 1.8);
+  EXPECT_DOUBLE_EQ(c.max_vy_mps, 1.5);
+  EXPECT_LT(c.a_min_m, c.space.a_m);
+  EXPECT_GT(c.a_max_m, c.space.a_m);
+}
+
+TEST(FollowEnv, TheObservationIsTheDaemonsLayoutAndTheMaskIsP) {
+  FollowEnv env(default_config(), 7);
+  Buffers b(env);
+  ASSERT_EQ(env.observation_size(), core::observation_size(64));
+  env.reset(b.obs, b.mask());
+  int free = 0;
+  for (int i = 0; i < 64; ++i) {
+    const bool in_p = b.mask()[static_cast<size_t>(i)];
+    free += in_p ? 1 : 0;
+    // s^p's flag of point i.
+    EXPECT_EQ(b.obs[4 * 64 + 3 * static_cast<size_t>(i) + 2], in_p ? 1.0f : 0.0f) << i;
+  }
+  EXPECT_GT(free, 0);
+  // The person in base_link (s^h) is where the robot started from them: 0.8-1.6 m.
+  const size_t h = 7 * 64 + 256 + 3;
+  EXPECT_NEAR(std::hypot(b.obs[h], b.obs[h + 1]), env.robot_person_distance_m(), 0.15);
+  EXPECT_GE(env.robot_person_distance_m(), 0.8 - 1e-9);
+  EXPECT_LE(env.robot_person_distance_m(), 1.6 + 1e-9);
+}
+
+TEST(FollowEnv, TheSameSeedGivesTheSameEpisodes) {
+  FollowEnv a(default_config(), 11), b(default_config(), 11), c(default_config(), 12);
+  Buffers ba(a), bb(b), bc(c);
+  a.reset(ba.obs, ba.mask());
+  b.reset(bb.obs, bb.mask());
+  c.reset(bc.obs, bc.mask());
+  EXPECT_NE(ba.obs, bc.obs);
+  for (int i = 0; i < 60; ++i) {
+    const int action = a.objective_action();
+    a.step(action, ba.obs, ba.mask());
+    b.step(action, bb.obs, bb.mask());
+    ASSERT_EQ(ba.obs, bb.obs) << "step " << i;
+  }
+}
+
+TEST(FollowEnv, AChoiceOutsidePFallsBackToTheObjective) {
+  FollowEnv env(default_config(), 3);
+  Buffers b(env);
+  env.reset(b.obs, b.mask());
+  const int objective = env.objective_action();
+  ASSERT_GE(objective, 0);
+  EXPECT_EQ(env.step(-1, b.obs, b.mask()).action_taken,
+            env.objective_action() >= 0 ? objective : -1);
+  for (int i = 0; i < 64; ++i) {
+    if (!b.mask()[static_cast<size_t>(i)]) {
+      const int expected = env.objective_action();
+      EXPECT_EQ(env.step(i, b.obs, b.mask()).action_taken, expected);
+      break;
+    }
+  }
+  // A point of P is taken as chosen.
+  for (int i = 0; i < 64; ++i) {
+    if (b.mask()[static_cast<size_t>(i)]) {
+      EXPECT_EQ(env.step(i, b.obs, b.mask()).action_taken, i);
+      break;
+    }
+  }
+}
+
+TEST(FollowEnv, TheRobotGoesToTheChosenPointAndStaysWithThePerson) {
+  // Open worlds, the point straight behind (index n/2, a = 0.8-1.2 m) from wherever the robot
+  // starts round the person (ahead of them too: the barrier takes it round, not through them):
+  // after 4 s it is that far from the person as they walk, and nothing ends the episode early.
+  FollowEnv env(open_world(), 21);
+  Buffers b(env);
+  for (int episode = 0; episode < 4; ++episode) {
+    env.reset(b.obs, b.mask());
+    double sum = 0, worst = 0;
+    int steps = 0, counted = 0;
+    for (;;) {
+      const auto r = env.step(32, b.obs, b.mask());
+      ASSERT_FALSE(r.terminated) << "episode " << episode << " step " << steps;
+      if (r.truncated) break;
+      if (++steps > 120) {
+        sum += env.robot_person_distance_m();
+        worst = std::max(worst, env.robot_person_distance_m());
+        ++counted;
+      }
+    }
+    EXPECT_GT(sum / counted, 0.75) << "episode " << episode;
+    EXPECT_LT(sum / counted, 1.35) << "episode " << episode;
+    EXPECT_LT(worst, 2.0) << "episode " << episode;
+    EXPECT_FALSE(env.last_episode().contact);
+    EXPECT_GT(env.last_episode().steps, 300);
+  }
+}
+
+TEST(FollowEnv, AContactEndsTheEpisodeWithTheCollisionReward) {
+  FollowEnvConfig c = open_world();
+  c.intimate_m = 5.0;  // the person's intimate zone covers the start
+  FollowEnv env(c, 5);
+  Buffers b(env);
+  env.reset(b.obs, b.mask());
+  const auto r = env.step(env.objective_action(), b.obs, b.mask());
+  EXPECT_TRUE(r.terminated);
+  EXPECT_EQ(r.rewards.collision, c.reward.collision_reward);
+  EXPECT_TRUE(env.last_episode().contact);
+  EXPECT_EQ(env.episodes(), 2U) << "the next observation starts a new episode";
+}
+
+TEST(FollowEnv, ThePersonLostEndsTheEpisode) {
+  FollowEnvConfig c = open_world();
+  c.far_m = 0.1;  // always "far"
+  c.far_max_s = 0.5;
+  FollowEnv env(c, 5);
+  Buffers b(env);
+  env.reset(b.obs, b.mask());
+  int steps = 0;
+  bool terminated = false;
+  while (!terminated && steps < 100) {
+    terminated = env.step(env.objective_action(), b.obs, b.mask()).terminated;
+    ++steps;
+  }
+  EXPECT_TRUE(terminated);
+  EXPECT_TRUE(env.last_episode().lost);
+  EXPECT_EQ(steps, 16) << "0.5 s at 30 Hz, then the step past it";
+}
