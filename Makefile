@@ -1,7 +1,7 @@
 # Thin wrappers over CMake presets. The two commands of the README:
 #   make run    install dependencies, build, run companiond on the simulated world (SCENARIO=...)
 #   make test   install dependencies, build, run every test (ThreadSanitizer pass included)
-.PHONY: run test deps build bench eval fuzz format tidy clean
+.PHONY: run test deps build bench eval train fuzz format tidy clean
 
 JOBS ?= $(shell nproc)
 TSAN_TARGETS := test_core_channel test_hal_clock test_firmware_executor test_firmware_daemon \
@@ -44,6 +44,17 @@ eval: deps
 	@cmake --preset release > /dev/null
 	@cmake --build --preset release -j $(JOBS) --target companion-eval
 	sim/eval/run_benchmark.sh $(EVAL_OUT)
+
+# PPO training of the learned selector (sim/training; LibTorch): writes TRAIN_OUT for policy.file
+# (docs/EVALUATION.md, "The learned policy").
+TRAIN_OUT ?= build/policy.bin
+TRAIN_STEPS ?= 1000000
+TRAIN_ARGS ?=
+train:
+	@bash toolchain/install-deps.sh --training
+	@cmake --preset release -DCOMPANION_BUILD_TRAINING=ON > /dev/null
+	@cmake --build --preset release -j $(JOBS) --target companion-train
+	./build/release/sim/companion-train --out $(TRAIN_OUT) --steps $(TRAIN_STEPS) --log $(TRAIN_OUT).csv $(TRAIN_ARGS)
 
 # Coverage-guided fuzzing of the decoders (clang + libFuzzer), FUZZ_SECONDS each, starting from
 # the seed corpora in tests/fuzz/corpus (copied: the repository is not modified).

@@ -281,10 +281,7 @@ int run(int argc, char** argv) {
   }
   // The learned selector, when configured: it must load completely, or the daemon does not start.
   if (!cfg.policy.file.empty()) {
-    const auto n = static_cast<uint32_t>(cfg.interactive_space.points);
-    core::PolicyLoadResult policy =
-        core::load_policy_file(cfg.policy.file, core::kObservationLayout, n,
-                               static_cast<uint32_t>(core::observation_size(n)));
+    core::PolicyLoadResult policy = firmware::load_configured_policy(cfg);
     if (!policy.policy) {
       spdlog::critical("{}", policy.error);
       firmware::shutdown_logging();

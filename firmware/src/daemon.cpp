@@ -123,6 +123,13 @@ core::InteractiveSpaceConfig interactive_space_config(const DaemonConfig& cfg) {
   return c;
 }
 
+core::PolicyLoadResult load_configured_policy(const DaemonConfig& cfg) {
+  if (cfg.policy.file.empty()) return {};
+  const auto n = static_cast<uint32_t>(cfg.interactive_space.points);
+  return core::load_policy_file(cfg.policy.file, core::kObservationLayout, n,
+                                static_cast<uint32_t>(core::observation_size(n)));
+}
+
 core::MppiConfig mppi_config(const DaemonConfig& cfg) {
   const auto& m = cfg.mppi;
   core::MppiConfig c;

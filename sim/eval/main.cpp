@@ -23,6 +23,7 @@
 
 #include "eval_plan.hpp"
 #include "firmware/config/config_loader.hpp"
+#include "firmware/daemon.hpp"
 #include "firmware/tool_console.hpp"
 #include "sim/pedestrian_dataset.hpp"
 #include "sim/run_report.hpp"
@@ -196,6 +197,13 @@ int run(int argc, char** argv) {
     if (m->name == "policy" && loaded.config->policy.file.empty()) {
       std::cerr << "method 'policy' needs a policy file (policy.file in --config)\n";
       return 2;
+    }
+    if (m->name == "policy") {
+      const auto policy = firmware::load_configured_policy(*loaded.config);
+      if (!policy.policy) {
+        std::cerr << "policy.file " << loaded.config->policy.file << ": " << policy.error << "\n";
+        return 2;
+      }
     }
     methods.push_back(*m);
   }

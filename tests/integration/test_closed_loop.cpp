@@ -6,8 +6,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <numeric>
 
+#include "core/policy/observation.hpp"
 #include "firmware/config/config_loader.hpp"
 #include "firmware/daemon.hpp"
 #include "scout_mini/scout_codec.hpp"
@@ -78,6 +80,50 @@ TEST(ClosedLoop, OpenSpaceKeepsThePersonWithinTheInteractionSpace) {
   EXPECT_LT(m.longest_far_s, 2.0) << "never more than 2 m away for long";
   EXPECT_LT(m.rmse_ex_m, 0.5);
   EXPECT_LT(m.rmse_ey_m, 0.5);
+}
+
+TEST(ClosedLoop, APolicyFileInTheConfigurationChoosesThePoint) {
+  // A policy whose logits do not depend on the observation and prefer point 16 (the person's
+  // left); the objective (alpha < 0) keeps the robot straight behind in the open. With
+  // policy.file set, the simulated daemon must choose the left point, as companiond would (the
+  // closed loop once ran the objective whatever the file said).
+  const int n = 64;
+  core::PolicyFile p;
+  p.layout_id = core::kObservationLayout;
+  p.points = n;
+  const auto in = static_cast<Eigen::Index>(core::observation_size(n));
+  p.mean = Eigen::VectorXf::Zero(in);
+  p.stddev = Eigen::VectorXf::Ones(in);
+  core::DenseLayer layer;
+  layer.weights = Eigen::MatrixXf::Zero(n, in);
+  layer.bias = Eigen::VectorXf::Zero(n);
+  layer.bias[16] = 10.0f;
+  p.layers.push_back(layer);
+  const std::string path = testing::TempDir() + "/left.policy";
+  const auto bytes = core::encode_policy(p);
+  std::ofstream(path, std::ios::binary)
+      .write(reinterpret_cast<const char*>(bytes.data()),
+             static_cast<std::streamsize>(bytes.size()));
+
+  auto o = scenario("open");
+  o.duration_s = 15;
+  std::array<int, 8> policy_sides{}, objective_sides{};
+  auto count = [](const sim::SimRunResult& r, std::array<int, 8>& sides) {
+    for (const auto& s : r.samples)
+      if (s.t_s > 5 && s.side >= 0) ++sides[static_cast<size_t>(s.side)];
+  };
+  count(sim::run_simulation(o), objective_sides);
+  o.config.policy.file = path;
+  count(sim::run_simulation(o), policy_sides);
+  const int total = std::accumulate(policy_sides.begin(), policy_sides.end(), 0);
+  ASSERT_GT(total, 50);
+  EXPECT_GT(policy_sides[2], total * 9 / 10) << "left of the person";
+  EXPECT_GT(objective_sides[4],
+            std::accumulate(objective_sides.begin(), objective_sides.end(), 0) / 2)
+      << "behind without the file";
+  // A file that does not load is an error, not a silent objective run.
+  o.config.policy.file = testing::TempDir() + "/missing.policy";
+  EXPECT_THROW(sim::run_simulation(o), std::runtime_error);
 }
 
 TEST(ClosedLoop, SwitchesSidesAroundAStaticObstacle) {

@@ -129,6 +129,9 @@ const char* side_of_person(int index, int points);
 int side_sector(int index, int points);
 const char* side_name(int sector);
 core::InteractiveSpaceConfig interactive_space_config(const DaemonConfig& cfg);
+// The learned selector's weights named by policy.file, checked against this configuration (n,
+// the observation layout). No file configured: no policy and no error.
+core::PolicyLoadResult load_configured_policy(const DaemonConfig& cfg);
 core::MppiConfig mppi_config(const DaemonConfig& cfg);
 core::PidFollowerConfig pid_follower_config(const DaemonConfig& cfg);
 

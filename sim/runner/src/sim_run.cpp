@@ -7,6 +7,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
 #include <thread>
 
 #include "firmware/daemon.hpp"
@@ -126,6 +127,13 @@ SimRunResult run_simulation(const SimRunOptions& o) {
   firmware::DaemonConfig cfg = o.config;
   cfg.mppi.seed = o.seed;
   firmware::Daemon daemon(cfg, notifier);
+  // The learned selector when policy.file names one, as companiond attaches it (a file that does
+  // not load is the caller's error: companion-eval checks it before any trial).
+  if (!cfg.policy.file.empty()) {
+    core::PolicyLoadResult policy = firmware::load_configured_policy(cfg);
+    if (!policy.policy) throw std::runtime_error("policy.file: " + policy.error);
+    daemon.attach_policy(std::move(*policy.policy));
+  }
   daemon.attach_base(world.take_base_bus());
   daemon.attach_tracker(world.take_tracker_link());
   daemon.attach_lidar(world.take_lidar_source());

@@ -86,6 +86,14 @@ int main(int argc, char** argv) {
   app.add_option("--eval-episodes", eval_episodes, "episodes per evaluation (fixed worlds)")
       ->check(CLI::PositiveNumber);
   app.add_option("--log", log_path, "CSV of the training (one row per evaluation)");
+  double sigma_h = -1, sigma_a = -1, tracking_distance = -1;
+  app.add_option("--sigma-h", sigma_h, "r^h weight per metre closed (default 100)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--sigma-a", sigma_a, "r^a weight per index of W the choice moves (default 0.5)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--tracking-distance", tracking_distance,
+                 "D: r_tracking within this distance of the person (the paper's 0.75 m)")
+      ->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
 
   const auto loaded = config_path.empty() ? firmware::load_default_config()
@@ -95,7 +103,10 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "%s\n", e.to_string().c_str());
     return 2;
   }
-  const FollowEnvConfig env_config = sim::training::follow_env_config(*loaded.config);
+  FollowEnvConfig env_config = sim::training::follow_env_config(*loaded.config);
+  if (sigma_h >= 0) env_config.reward.sigma_h_per_m = sigma_h;
+  if (sigma_a >= 0) env_config.reward.sigma_a_per_index = sigma_a;
+  if (tracking_distance > 0) env_config.reward.tracking_distance_m = tracking_distance;
 
   // Worlds: training seeds from 1 000 000 (the benchmark uses 1-50, validation 101-180);
   // evaluation worlds from 9 000 000.
