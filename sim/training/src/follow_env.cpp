@@ -298,8 +298,10 @@ StepResult FollowEnv::step(int action, std::span<float> observation, std::span<b
     crowd_.step(dt, scenario_.world, bodies_);
     const double clearance = obstacle_clearance_m();
     if (clearance < config_.reward.safety_clearance_m) near_s += dt;
-    if (clearance < config_.robot_radius_m || robot_person_distance_m() < config_.intimate_m) {
+    const bool person_contact = robot_person_distance_m() < config_.intimate_m;
+    if (clearance < config_.robot_radius_m || person_contact) {
       contact = true;
+      episode_.contact_person = person_contact;
       break;
     }
     if (t_s_ >= next_scan_s_) {

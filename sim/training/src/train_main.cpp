@@ -33,7 +33,7 @@ class FollowEnvironment final : public sim::training::Environment {
 
 struct EvalResult {
   double mean_return = 0;
-  double contact_rate = 0, lost_rate = 0;
+  double contact_rate = 0, person_contact_rate = 0, lost_rate = 0;
   double near_obstacle_s = 0;  // per episode
 };
 
@@ -57,6 +57,7 @@ EvalResult evaluate(const FollowEnvConfig& config, int episodes, uint64_t first_
     const auto& e = env.last_episode();
     r.mean_return += e.return_sum / episodes;
     r.contact_rate += (e.contact ? 1.0 : 0.0) / episodes;
+    r.person_contact_rate += (e.contact_person ? 1.0 : 0.0) / episodes;
     r.lost_rate += (e.lost ? 1.0 : 0.0) / episodes;
     r.near_obstacle_s += e.near_obstacle_s / episodes;
   }
@@ -94,6 +95,16 @@ int main(int argc, char** argv) {
   app.add_option("--tracking-distance", tracking_distance,
                  "D: r_tracking within this distance of the person (the paper's 0.75 m)")
       ->check(CLI::PositiveNumber);
+  sim::training::PpoConfig ppo;
+  app.add_option("--entropy", ppo.entropy_scale,
+                 "entropy bonus (skrl's default 0; a deterministic policy then has KL 0 and "
+                 "the KL-adaptive schedule raises the rate to lr_max)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--lr-max", ppo.lr_max, "the KL-adaptive schedule's ceiling (skrl: 1e-2)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--rollout-steps", ppo.rollout_steps,
+                 "steps per environment per update (skrl: 16)")
+      ->check(CLI::Range(2, 4096));
   CLI11_PARSE(app, argc, argv);
 
   const auto loaded = config_path.empty() ? firmware::load_default_config()
@@ -117,7 +128,6 @@ int main(int argc, char** argv) {
         env_config, 1000000 + seed * 1000 + static_cast<uint64_t>(i)));
     list.push_back(owned.back().get());
   }
-  sim::training::PpoConfig ppo;
   ppo.seed = seed;
   sim::training::PpoTrainer trainer(ppo, list);
   const uint64_t eval_seed = 9000000;
@@ -128,9 +138,10 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (log != nullptr) {
-    std::fprintf(log,
-                 "update,env_steps,wall_s,learning_rate,kl,mean_reward,eval_return,"
-                 "eval_contact_rate,eval_lost_rate,eval_near_obstacle_s\n");
+    std::fprintf(
+        log,
+        "update,env_steps,wall_s,learning_rate,kl,mean_reward,eval_return,"
+        "eval_contact_rate,eval_person_contact_rate,eval_lost_rate,eval_near_obstacle_s\n");
   }
   const auto t0 = std::chrono::steady_clock::now();
   auto wall = [&] {
@@ -141,10 +152,10 @@ int main(int argc, char** argv) {
       evaluate(env_config, eval_episodes, eval_seed,
                [](FollowEnv& env, auto&, auto&) { return env.objective_action(); });
   std::printf(
-      "objective selector on %d evaluation worlds: return %.0f, contact %.0f %%, lost %.0f %%, "
-      "near obstacles %.1f s\n",
-      eval_episodes, baseline.mean_return, 100 * baseline.contact_rate, 100 * baseline.lost_rate,
-      baseline.near_obstacle_s);
+      "objective selector on %d evaluation worlds: return %.0f, contact %.0f %% (the person %.0f "
+      "%%), lost %.0f %%, near obstacles %.1f s\n",
+      eval_episodes, baseline.mean_return, 100 * baseline.contact_rate,
+      100 * baseline.person_contact_rate, 100 * baseline.lost_rate, baseline.near_obstacle_s);
   if (imitate_rollouts > 0) {
     const double acc = trainer.imitate([&](size_t e) { return owned[e]->env.objective_action(); },
                                        imitate_rollouts);
@@ -176,15 +187,17 @@ int main(int argc, char** argv) {
       const EvalResult r = evaluate(env_config, eval_episodes, eval_seed, greedy);
       std::printf(
           "update %5d  steps %8llu  %6.0f s  lr %.1e  kl %.4f  reward/step %7.2f  "
-          "eval return %7.0f (objective %.0f)  contact %3.0f %%  lost %3.0f %%\n",
+          "eval return %7.0f (objective %.0f)  contact %3.0f %% (the person %3.0f %%)  lost %3.0f "
+          "%%\n",
           update, static_cast<unsigned long long>(done_steps), wall(), s.learning_rate, s.kl,
           s.mean_reward, r.mean_return, baseline.mean_return, 100 * r.contact_rate,
-          100 * r.lost_rate);
+          100 * r.person_contact_rate, 100 * r.lost_rate);
       std::fflush(stdout);
       if (log != nullptr) {
-        std::fprintf(log, "%d,%llu,%.1f,%.3g,%.5f,%.3f,%.1f,%.3f,%.3f,%.2f\n", update,
+        std::fprintf(log, "%d,%llu,%.1f,%.3g,%.5f,%.3f,%.1f,%.3f,%.3f,%.3f,%.2f\n", update,
                      static_cast<unsigned long long>(done_steps), wall(), s.learning_rate, s.kl,
-                     s.mean_reward, r.mean_return, r.contact_rate, r.lost_rate, r.near_obstacle_s);
+                     s.mean_reward, r.mean_return, r.contact_rate, r.person_contact_rate,
+                     r.lost_rate, r.near_obstacle_s);
         std::fflush(log);
       }
       save(r.mean_return, update);

@@ -112,6 +112,8 @@ struct EpisodeStats {
   double return_sum = 0;
   int steps = 0;
   bool contact = false;
+  bool contact_person =
+      false;  // the contact was the followed person (else an obstacle or a pedestrian)
   bool lost = false;
   double near_obstacle_s = 0;  // time with r^c
 };
