@@ -46,6 +46,18 @@ class MaskedBandit final : public Environment {
   int target_ = 0, masked_ = 1;
 };
 
+// n bandits seeded from `first_seed`, and the trainer's view of them.
+struct Bandits {
+  Bandits(int n, uint64_t first_seed) {
+    for (int i = 0; i < n; ++i)
+      envs.emplace_back(first_seed + static_cast<uint64_t>(i));
+    for (auto& e : envs)
+      list.push_back(&e);
+  }
+  std::vector<MaskedBandit> envs;
+  std::vector<Environment*> list;
+};
+
 double greedy_accuracy(PpoTrainer& trainer, MaskedBandit& env, int trials, int* masked_picks) {
   std::vector<float> o(6);
   std::vector<uint8_t> mb(4);
@@ -86,17 +98,12 @@ TEST(Ppo, GeneralisedAdvantageEstimateByHand) {
 }
 
 TEST(Ppo, LearnsAMaskedChoiceItStartsIgnorantOf) {
-  std::vector<MaskedBandit> envs;
-  for (uint64_t i = 0; i < 8; ++i)
-    envs.emplace_back(100 + i);
-  std::vector<Environment*> list;
-  for (auto& e : envs)
-    list.push_back(&e);
+  Bandits bandits(8, 100);
   PpoConfig config;
   config.hidden = {32, 32};
   config.reward_scale = 1.0;
   config.seed = 3;
-  PpoTrainer trainer(config, list);
+  PpoTrainer trainer(config, bandits.list);
   MaskedBandit probe(999);
   int masked = 0;
   const double before = greedy_accuracy(trainer, probe, 300, &masked);
@@ -109,15 +116,10 @@ TEST(Ppo, LearnsAMaskedChoiceItStartsIgnorantOf) {
 }
 
 TEST(Ppo, TheExportedFileIsTheActorInTheDaemonsRuntime) {
-  std::vector<MaskedBandit> envs;
-  for (uint64_t i = 0; i < 4; ++i)
-    envs.emplace_back(200 + i);
-  std::vector<Environment*> list;
-  for (auto& e : envs)
-    list.push_back(&e);
+  Bandits bandits(4, 200);
   PpoConfig config;
   config.hidden = {16, 8};
-  PpoTrainer trainer(config, list);
+  PpoTrainer trainer(config, bandits.list);
   for (int u = 0; u < 5; ++u)
     trainer.update();  // weights and standardiser away from the start
 
