@@ -116,7 +116,7 @@ struct PpoTrainer::Impl {
     lr = config.learning_rate;
     const size_t n = envs.size();
     obs.assign(n * obs_size, 0.0f);
-    mask.assign(n * static_cast<size_t>(actions), 0);
+    mask = std::make_unique<bool[]>(n * static_cast<size_t>(actions));
     for (size_t i = 0; i < n; ++i)
       reset_env(i);
   }
@@ -125,8 +125,7 @@ struct PpoTrainer::Impl {
     envs[i]->reset(std::span<float>(&obs[i * obs_size], obs_size), mask_of(i));
   }
   std::span<bool> mask_of(size_t i) {
-    return {reinterpret_cast<bool*>(&mask[i * static_cast<size_t>(actions)]),
-            static_cast<size_t>(actions)};
+    return {&mask[i * static_cast<size_t>(actions)], static_cast<size_t>(actions)};
   }
 
   // Standardised observations of `rows` raw rows as a tensor.
@@ -179,8 +178,8 @@ struct PpoTrainer::Impl {
   std::unique_ptr<torch::optim::Adam> optimizer;
   double lr;
   std::mt19937_64 rng;
-  std::vector<float> obs;     // current raw observation per environment
-  std::vector<uint8_t> mask;  // current mask per environment
+  std::vector<float> obs;        // current raw observation per environment
+  std::unique_ptr<bool[]> mask;  // current mask per environment
   uint64_t env_steps = 0;
 };
 
@@ -214,10 +213,11 @@ UpdateStats PpoTrainer::update() {
       const size_t base = static_cast<size_t>(t) * static_cast<size_t>(N);
       std::copy(m.obs.begin(), m.obs.end(),
                 raw.begin() + static_cast<ptrdiff_t>(base * m.obs_size));
-      std::copy(m.mask.begin(), m.mask.end(), masks.begin() + static_cast<ptrdiff_t>(base * A));
+      std::copy(m.mask.get(), m.mask.get() + static_cast<size_t>(N) * A,
+                masks.begin() + static_cast<ptrdiff_t>(base * A));
       const auto x = m.standardise(m.obs.data(), static_cast<size_t>(N));
-      const auto logits =
-          Impl::masked(m.actor->forward(x), m.mask_tensor(m.mask.data(), static_cast<size_t>(N)));
+      const auto logits = Impl::masked(m.actor->forward(x),
+                                       m.mask_tensor(&masks[base * A], static_cast<size_t>(N)));
       const auto lp = torch::log_softmax(logits, 1).contiguous();
       const auto probs = lp.exp().contiguous();
       const auto v = m.critic->forward(x).squeeze(1).contiguous();
@@ -344,8 +344,7 @@ double PpoTrainer::imitate(const std::function<int(size_t env)>& teacher, int ro
       if (a >= 0) {
         raw.insert(raw.end(), m.obs.begin() + static_cast<ptrdiff_t>(e * m.obs_size),
                    m.obs.begin() + static_cast<ptrdiff_t>((e + 1) * m.obs_size));
-        masks.insert(masks.end(), m.mask.begin() + static_cast<ptrdiff_t>(e * A),
-                     m.mask.begin() + static_cast<ptrdiff_t>((e + 1) * A));
+        masks.insert(masks.end(), m.mask.get() + e * A, m.mask.get() + (e + 1) * A);
         targets.push_back(a);
       }
       m.envs[e]->step(a, std::span<float>(&m.obs[e * m.obs_size], m.obs_size), m.mask_of(e));

@@ -46,8 +46,9 @@ EvalResult evaluate(const FollowEnvConfig& config, int episodes, uint64_t first_
   for (int i = 0; i < episodes; ++i) {
     FollowEnv env(config, first_seed + static_cast<uint64_t>(i));
     std::vector<float> obs(env.observation_size());
-    std::vector<uint8_t> mask_bytes(static_cast<size_t>(env.points()));
-    std::span<bool> mask(reinterpret_cast<bool*>(mask_bytes.data()), mask_bytes.size());
+    const auto points = static_cast<size_t>(env.points());
+    const auto mask_storage = std::make_unique<bool[]>(points);
+    const std::span<bool> mask(mask_storage.get(), points);
     env.reset(obs, mask);
     while (env.episodes() == 1) {
       const int a = choose(env, obs, mask);

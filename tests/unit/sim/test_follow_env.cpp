@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <vector>
 
 #include "core/policy/observation.hpp"
@@ -34,10 +35,13 @@ FollowEnvConfig open_world() {
 
 struct Buffers {
   explicit Buffers(const FollowEnv& env)
-      : obs(env.observation_size()), mask_bytes(static_cast<size_t>(env.points())) {}
-  std::span<bool> mask() { return {reinterpret_cast<bool*>(mask_bytes.data()), mask_bytes.size()}; }
+      : obs(env.observation_size()),
+        points(static_cast<size_t>(env.points())),
+        mask_storage(std::make_unique<bool[]>(points)) {}
+  std::span<bool> mask() { return {mask_storage.get(), points}; }
   std::vector<float> obs;
-  std::vector<uint8_t> mask_bytes;
+  size_t points;
+  std::unique_ptr<bool[]> mask_storage;
 };
 
 }  // namespace

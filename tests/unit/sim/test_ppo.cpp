@@ -60,8 +60,8 @@ struct Bandits {
 
 double greedy_accuracy(PpoTrainer& trainer, MaskedBandit& env, int trials, int* masked_picks) {
   std::vector<float> o(6);
-  std::vector<uint8_t> mb(4);
-  std::span<bool> m(reinterpret_cast<bool*>(mb.data()), 4);
+  bool mb[4] = {};
+  std::span<bool> m(mb);
   env.reset(o, m);
   int right = 0;
   for (int i = 0; i < trials; ++i) {
