@@ -43,9 +43,10 @@ struct Standardiser {
   void add(const float* rows, size_t count, size_t width) {
     if (count == 0) return;
     std::vector<double> bm(width, 0.0), bv(width, 0.0);
-    for (size_t r = 0; r < count; ++r)
+    for (size_t r = 0; r < count; ++r) {
       for (size_t j = 0; j < width; ++j)
         bm[j] += static_cast<double>(rows[r * width + j]);
+    }
     for (double& v : bm)
       v /= static_cast<double>(count);
     for (size_t r = 0; r < count; ++r) {
@@ -196,36 +197,39 @@ PpoTrainer::~PpoTrainer() = default;
 
 UpdateStats PpoTrainer::update() {
   Impl& m = *impl_;
-  const int T = m.config.rollout_steps;
-  const int N = static_cast<int>(m.envs.size());
-  const size_t rows = static_cast<size_t>(T) * static_cast<size_t>(N);
-  const size_t A = static_cast<size_t>(m.actions);
+  const int steps = m.config.rollout_steps;
+  const int env_count = static_cast<int>(m.envs.size());
+  const size_t rows = static_cast<size_t>(steps) * static_cast<size_t>(env_count);
+  const size_t action_count = static_cast<size_t>(m.actions);
   std::vector<float> raw(rows * m.obs_size);
-  std::vector<uint8_t> masks(rows * A);
+  std::vector<uint8_t> masks(rows * action_count);
   std::vector<int64_t> acts(rows);
-  std::vector<float> logp(rows), values(rows), rewards(rows), last_values(static_cast<size_t>(N));
+  std::vector<float> logp(rows), values(rows), rewards(rows),
+      last_values(static_cast<size_t>(env_count));
   std::vector<uint8_t> done(rows);
   torch::Tensor obs_t;
   double reward_sum = 0;
   {
     torch::NoGradGuard no_grad;
-    for (int t = 0; t < T; ++t) {
-      const size_t base = static_cast<size_t>(t) * static_cast<size_t>(N);
+    for (int t = 0; t < steps; ++t) {
+      const size_t base = static_cast<size_t>(t) * static_cast<size_t>(env_count);
       std::copy(m.obs.begin(), m.obs.end(),
                 raw.begin() + static_cast<ptrdiff_t>(base * m.obs_size));
-      std::copy(m.mask.get(), m.mask.get() + static_cast<size_t>(N) * A,
-                masks.begin() + static_cast<ptrdiff_t>(base * A));
-      const auto x = m.standardise(m.obs.data(), static_cast<size_t>(N));
-      const auto logits = Impl::masked(m.actor->forward(x),
-                                       m.mask_tensor(&masks[base * A], static_cast<size_t>(N)));
+      std::copy(m.mask.get(), m.mask.get() + static_cast<size_t>(env_count) * action_count,
+                masks.begin() + static_cast<ptrdiff_t>(base * action_count));
+      const auto x = m.standardise(m.obs.data(), static_cast<size_t>(env_count));
+      const auto logits =
+          Impl::masked(m.actor->forward(x),
+                       m.mask_tensor(&masks[base * action_count], static_cast<size_t>(env_count)));
       const auto lp = torch::log_softmax(logits, 1).contiguous();
       const auto probs = lp.exp().contiguous();
       const auto v = m.critic->forward(x).squeeze(1).contiguous();
-      for (int e = 0; e < N; ++e) {
+      for (int e = 0; e < env_count; ++e) {
         const size_t i = base + static_cast<size_t>(e);
-        const int a = m.sample(probs.data_ptr<float>() + static_cast<size_t>(e) * A);
+        const int a = m.sample(probs.data_ptr<float>() + static_cast<size_t>(e) * action_count);
         acts[i] = a;
-        logp[i] = lp.data_ptr<float>()[static_cast<size_t>(e) * A + static_cast<size_t>(a)];
+        logp[i] =
+            lp.data_ptr<float>()[static_cast<size_t>(e) * action_count + static_cast<size_t>(a)];
         values[i] = v.data_ptr<float>()[e];
         const auto out = m.envs[static_cast<size_t>(e)]->step(
             a, std::span<float>(&m.obs[static_cast<size_t>(e) * m.obs_size], m.obs_size),
@@ -235,15 +239,15 @@ UpdateStats PpoTrainer::update() {
         done[i] = (out.terminated || out.truncated) ? 1 : 0;
       }
     }
-    const auto x = m.standardise(m.obs.data(), static_cast<size_t>(N));
+    const auto x = m.standardise(m.obs.data(), static_cast<size_t>(env_count));
     const auto v = m.critic->forward(x).squeeze(1).contiguous();
-    std::copy(v.data_ptr<float>(), v.data_ptr<float>() + N, last_values.begin());
+    std::copy(v.data_ptr<float>(), v.data_ptr<float>() + env_count, last_values.begin());
   }
   m.env_steps += rows;
 
   std::vector<float> adv(rows), ret(rows);
-  compute_gae(rewards, values, done, last_values, T, N, m.config.discount, m.config.gae_lambda, adv,
-              ret);
+  compute_gae(rewards, values, done, last_values, steps, env_count, m.config.discount,
+              m.config.gae_lambda, adv, ret);
   // Normalised advantages over the rollout.
   const double mean = std::accumulate(adv.begin(), adv.end(), 0.0) / static_cast<double>(rows);
   double var = 0;
@@ -253,8 +257,8 @@ UpdateStats PpoTrainer::update() {
   for (float& a : adv)
     a = static_cast<float>((static_cast<double>(a) - mean) / sd);
 
-  const auto X = m.standardise(raw.data(), rows);
-  const auto M = m.mask_tensor(masks.data(), rows);
+  const auto obs_all = m.standardise(raw.data(), rows);
+  const auto mask_all = m.mask_tensor(masks.data(), rows);
   const auto act_t =
       torch::from_blob(acts.data(), {static_cast<int64_t>(rows)}, torch::kInt64).clone();
   const auto old_logp =
@@ -277,9 +281,9 @@ UpdateStats PpoTrainer::update() {
     int kl_count = 0;
     for (int b = 0; b < m.config.minibatches; ++b) {
       const auto idx = torch::from_blob(order.data() + b * batch, {batch}, torch::kInt64).clone();
-      const auto x = X.index_select(0, idx);
+      const auto x = obs_all.index_select(0, idx);
       const auto lp_all =
-          torch::log_softmax(Impl::masked(m.actor->forward(x), M.index_select(0, idx)), 1);
+          torch::log_softmax(Impl::masked(m.actor->forward(x), mask_all.index_select(0, idx)), 1);
       const auto a = act_t.index_select(0, idx);
       const auto new_logp = lp_all.gather(1, a.unsqueeze(1)).squeeze(1);
       const auto log_ratio = new_logp - old_logp.index_select(0, idx);
@@ -333,30 +337,31 @@ UpdateStats PpoTrainer::update() {
 
 double PpoTrainer::imitate(const std::function<int(size_t env)>& teacher, int rollouts) {
   Impl& m = *impl_;
-  const size_t N = m.envs.size();
-  const size_t A = static_cast<size_t>(m.actions);
+  const size_t env_count = m.envs.size();
+  const size_t action_count = static_cast<size_t>(m.actions);
   std::vector<float> raw;
   std::vector<uint8_t> masks;
   std::vector<int64_t> targets;
   for (int r = 0; r < rollouts * m.config.rollout_steps; ++r) {
-    for (size_t e = 0; e < N; ++e) {
+    for (size_t e = 0; e < env_count; ++e) {
       const int a = teacher(e);
       if (a >= 0) {
         raw.insert(raw.end(), m.obs.begin() + static_cast<ptrdiff_t>(e * m.obs_size),
                    m.obs.begin() + static_cast<ptrdiff_t>((e + 1) * m.obs_size));
-        masks.insert(masks.end(), m.mask.get() + e * A, m.mask.get() + (e + 1) * A);
+        masks.insert(masks.end(), m.mask.get() + e * action_count,
+                     m.mask.get() + (e + 1) * action_count);
         targets.push_back(a);
       }
       m.envs[e]->step(a, std::span<float>(&m.obs[e * m.obs_size], m.obs_size), m.mask_of(e));
     }
   }
-  m.env_steps += static_cast<uint64_t>(rollouts * m.config.rollout_steps) * N;
+  m.env_steps += static_cast<uint64_t>(rollouts * m.config.rollout_steps) * env_count;
   const size_t rows = targets.size();
   if (rows == 0) return 0.0;
   m.scaler.add(raw.data(), rows, m.obs_size);
-  const auto X = m.standardise(raw.data(), rows);
-  const auto M = m.mask_tensor(masks.data(), rows);
-  const auto Y =
+  const auto obs_all = m.standardise(raw.data(), rows);
+  const auto mask_all = m.mask_tensor(masks.data(), rows);
+  const auto target_all =
       torch::from_blob(targets.data(), {static_cast<int64_t>(rows)}, torch::kInt64).clone();
   torch::optim::Adam opt(m.actor->parameters(), torch::optim::AdamOptions(1e-3));
   const int64_t batch = 256;
@@ -367,17 +372,18 @@ double PpoTrainer::imitate(const std::function<int(size_t env)>& teacher, int ro
     for (int64_t s = 0; s < static_cast<int64_t>(rows); s += batch) {
       const int64_t len = std::min<int64_t>(batch, static_cast<int64_t>(rows) - s);
       const auto idx = torch::from_blob(order.data() + s, {len}, torch::kInt64).clone();
-      const auto logits =
-          Impl::masked(m.actor->forward(X.index_select(0, idx)), M.index_select(0, idx));
-      const auto loss = torch::nll_loss(torch::log_softmax(logits, 1), Y.index_select(0, idx));
+      const auto logits = Impl::masked(m.actor->forward(obs_all.index_select(0, idx)),
+                                       mask_all.index_select(0, idx));
+      const auto loss =
+          torch::nll_loss(torch::log_softmax(logits, 1), target_all.index_select(0, idx));
       opt.zero_grad();
       loss.backward();
       opt.step();
     }
   }
   torch::NoGradGuard no_grad;
-  const auto pred = Impl::masked(m.actor->forward(X), M).argmax(1);
-  return pred.eq(Y).to(torch::kFloat32).mean().item<double>();
+  const auto pred = Impl::masked(m.actor->forward(obs_all), mask_all).argmax(1);
+  return pred.eq(target_all).to(torch::kFloat32).mean().item<double>();
 }
 
 std::vector<float> PpoTrainer::logits(std::span<const float> observation) {

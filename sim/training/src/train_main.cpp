@@ -1,11 +1,15 @@
 // companion-train: PPO training of the learned selector in the training environment
 // (sim/training/follow_env.hpp), written as a policy file companiond reads (policy.file).
 // Optional build: cmake -DCOMPANION_BUILD_TRAINING=ON (needs libtorch-dev).
+#include <fmt/format.h>
+
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <memory>
+#include <stdexcept>
 #include <vector>
 
 #include "core/policy/observation.hpp"
@@ -65,9 +69,21 @@ EvalResult evaluate(const FollowEnvConfig& config, int episodes, uint64_t first_
   return r;
 }
 
-}  // namespace
+// Writes the policy file whole or not at all (a temporary beside it, then a rename).
+bool write_policy(const std::string& path, const std::vector<uint8_t>& bytes) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary);
+    f.write(reinterpret_cast<const char*>(bytes.data()),
+            static_cast<std::streamsize>(bytes.size()));
+    if (!f.good()) return false;
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  return !ec;
+}
 
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   CLI::App app{
       "companion-train: PPO for the learned selector (writes a policy file for policy.file)"};
   std::string out, config_path, log_path;
@@ -112,7 +128,7 @@ int main(int argc, char** argv) {
                                           : firmware::load_config_file(config_path);
   if (!loaded.ok()) {
     for (const auto& e : loaded.errors)
-      std::fprintf(stderr, "%s\n", e.to_string().c_str());
+      fmt::print(stderr, "{}\n", e.to_string());
     return 2;
   }
   FollowEnvConfig env_config = sim::training::follow_env_config(*loaded.config);
@@ -133,16 +149,15 @@ int main(int argc, char** argv) {
   sim::training::PpoTrainer trainer(ppo, list);
   const uint64_t eval_seed = 9000000;
 
-  std::FILE* log = log_path.empty() ? nullptr : std::fopen(log_path.c_str(), "w");
-  if (!log_path.empty() && log == nullptr) {
-    std::fprintf(stderr, "cannot write %s\n", log_path.c_str());
-    return 2;
-  }
-  if (log != nullptr) {
-    std::fprintf(
-        log,
-        "update,env_steps,wall_s,learning_rate,kl,mean_reward,eval_return,"
-        "eval_contact_rate,eval_person_contact_rate,eval_lost_rate,eval_near_obstacle_s\n");
+  std::ofstream log;
+  if (!log_path.empty()) {
+    log.open(log_path);
+    if (!log) {
+      fmt::print(stderr, "cannot write {}\n", log_path);
+      return 2;
+    }
+    log << "update,env_steps,wall_s,learning_rate,kl,mean_reward,eval_return,"
+           "eval_contact_rate,eval_person_contact_rate,eval_lost_rate,eval_near_obstacle_s\n";
   }
   const auto t0 = std::chrono::steady_clock::now();
   auto wall = [&] {
@@ -152,16 +167,16 @@ int main(int argc, char** argv) {
   const EvalResult baseline =
       evaluate(env_config, eval_episodes, eval_seed,
                [](FollowEnv& env, auto&, auto&) { return env.objective_action(); });
-  std::printf(
-      "objective selector on %d evaluation worlds: return %.0f, contact %.0f %% (the person %.0f "
-      "%%), lost %.0f %%, near obstacles %.1f s\n",
+  fmt::print(
+      "objective selector on {} evaluation worlds: return {:.0f}, contact {:.0f} % (the person "
+      "{:.0f} %), lost {:.0f} %, near obstacles {:.1f} s\n",
       eval_episodes, baseline.mean_return, 100 * baseline.contact_rate,
       100 * baseline.person_contact_rate, 100 * baseline.lost_rate, baseline.near_obstacle_s);
   if (imitate_rollouts > 0) {
     const double acc = trainer.imitate([&](size_t e) { return owned[e]->env.objective_action(); },
                                        imitate_rollouts);
-    std::printf("imitation of the objective selector: %.1f %% of its choices (%.0f s)\n", 100 * acc,
-                wall());
+    fmt::print("imitation of the objective selector: {:.1f} % of its choices ({:.0f} s)\n",
+               100 * acc, wall());
   }
 
   auto greedy = [&](FollowEnv&, std::vector<float>& obs, std::span<bool> mask) {
@@ -172,10 +187,8 @@ int main(int argc, char** argv) {
     if (score <= best) return;
     best = score;
     const auto bytes = core::encode_policy(trainer.export_policy(core::kObservationLayout));
-    std::ofstream f(out, std::ios::binary);
-    f.write(reinterpret_cast<const char*>(bytes.data()),
-            static_cast<std::streamsize>(bytes.size()));
-    std::printf("  wrote %s (update %d, evaluation return %.0f)\n", out.c_str(), update, score);
+    if (!write_policy(out, bytes)) throw std::runtime_error("cannot write the policy file " + out);
+    fmt::print("  wrote {} (update {}, evaluation return {:.0f})\n", out, update, score);
   };
 
   int update = 0;
@@ -186,27 +199,36 @@ int main(int argc, char** argv) {
     ++update;
     if (update % eval_every == 0 || done_steps >= steps) {
       const EvalResult r = evaluate(env_config, eval_episodes, eval_seed, greedy);
-      std::printf(
-          "update %5d  steps %8llu  %6.0f s  lr %.1e  kl %.4f  reward/step %7.2f  "
-          "eval return %7.0f (objective %.0f)  contact %3.0f %% (the person %3.0f %%)  lost %3.0f "
-          "%%\n",
-          update, static_cast<unsigned long long>(done_steps), wall(), s.learning_rate, s.kl,
-          s.mean_reward, r.mean_return, baseline.mean_return, 100 * r.contact_rate,
-          100 * r.person_contact_rate, 100 * r.lost_rate);
-      std::fflush(stdout);
-      if (log != nullptr) {
-        std::fprintf(log, "%d,%llu,%.1f,%.3g,%.5f,%.3f,%.1f,%.3f,%.3f,%.3f,%.2f\n", update,
-                     static_cast<unsigned long long>(done_steps), wall(), s.learning_rate, s.kl,
-                     s.mean_reward, r.mean_return, r.contact_rate, r.person_contact_rate,
-                     r.lost_rate, r.near_obstacle_s);
-        std::fflush(log);
+      fmt::print(
+          "update {:5d}  steps {:8d}  {:6.0f} s  lr {:.1e}  kl {:.4f}  reward/step {:7.2f}  "
+          "eval return {:7.0f} (objective {:.0f})  contact {:3.0f} % (the person {:3.0f} %)  lost "
+          "{:3.0f} %\n",
+          update, done_steps, wall(), s.learning_rate, s.kl, s.mean_reward, r.mean_return,
+          baseline.mean_return, 100 * r.contact_rate, 100 * r.person_contact_rate,
+          100 * r.lost_rate);
+      std::fflush(stdout);  // NOLINT(cert-err33-c): progress lines, nothing to do on failure
+      if (log.is_open()) {
+        log << fmt::format("{},{},{:.1f},{:.3g},{:.5f},{:.3f},{:.1f},{:.3f},{:.3f},{:.3f},{:.2f}\n",
+                           update, done_steps, wall(), s.learning_rate, s.kl, s.mean_reward,
+                           r.mean_return, r.contact_rate, r.person_contact_rate, r.lost_rate,
+                           r.near_obstacle_s)
+            << std::flush;
       }
       save(r.mean_return, update);
     }
   }
-  if (log != nullptr) std::fclose(log);
-  std::printf("done: %llu steps in %.0f s (%.0f steps/s)\n",
-              static_cast<unsigned long long>(done_steps), wall(),
-              static_cast<double>(done_steps) / wall());
+  fmt::print("done: {} steps in {:.0f} s ({:.0f} steps/s)\n", done_steps, wall(),
+             static_cast<double>(done_steps) / wall());
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "companion-train: {}\n", e.what());
+    return 1;
+  }
 }
