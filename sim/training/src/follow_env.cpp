@@ -316,6 +316,17 @@ StepResult FollowEnv::step(int action, std::span<float> observation, std::span<b
   result.rewards =
       step_rewards(config_.reward, previous_distance_m_, distance, result.action_taken,
                    previous_action_, config_.space.points, obstacle_clearance_m(), contact);
+  if (previous_action_ >= 0 && result.action_taken >= 0 &&
+      previous_action_ != result.action_taken) {
+    // The distance between the two points of W in the person's frame (companion-eval's
+    // "q^d jumps" counts the same in the closed loop's samples).
+    const auto point = [&](int i) {
+      const double phi = 2.0 * std::numbers::pi * i / config_.space.points;
+      return core::Point2{space_.config().a_m * std::cos(phi), space_.config().b_m * std::sin(phi)};
+    };
+    const core::Point2 p = point(previous_action_), q = point(result.action_taken);
+    if (std::hypot(p.x_m - q.x_m, p.y_m - q.y_m) > 0.3) ++episode_.jumps;
+  }
   previous_distance_m_ = distance;
   previous_action_ = result.action_taken;
   result.terminated = contact || lost;
@@ -323,6 +334,7 @@ StepResult FollowEnv::step(int action, std::span<float> observation, std::span<b
 
   episode_.return_sum += result.rewards.total();
   episode_.steps += 1;
+  episode_.duration_s = t_s_;
   episode_.contact = episode_.contact || contact;
   episode_.lost = episode_.lost || lost;
   episode_.near_obstacle_s += near_s;

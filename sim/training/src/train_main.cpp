@@ -39,6 +39,7 @@ struct EvalResult {
   double mean_return = 0;
   double contact_rate = 0, person_contact_rate = 0, lost_rate = 0;
   double near_obstacle_s = 0;  // per episode
+  double jumps_per_min = 0;    // the chosen point moving > 0.3 m between decisions
 };
 
 // `episodes` whole episodes on fixed seeds (the same worlds for every call), choosing with
@@ -47,6 +48,7 @@ template <typename Choose>
 EvalResult evaluate(const FollowEnvConfig& config, int episodes, uint64_t first_seed,
                     Choose&& choose) {
   EvalResult r;
+  double jumps = 0, seconds = 0;
   for (int i = 0; i < episodes; ++i) {
     FollowEnv env(config, first_seed + static_cast<uint64_t>(i));
     std::vector<float> obs(env.observation_size());
@@ -65,7 +67,10 @@ EvalResult evaluate(const FollowEnvConfig& config, int episodes, uint64_t first_
     r.person_contact_rate += (e.contact_person ? 1.0 : 0.0) / episodes;
     r.lost_rate += (e.lost ? 1.0 : 0.0) / episodes;
     r.near_obstacle_s += e.near_obstacle_s / episodes;
+    jumps += e.jumps;
+    seconds += e.duration_s;
   }
+  r.jumps_per_min = seconds > 0 ? 60.0 * jumps / seconds : 0.0;
   return r;
 }
 
@@ -89,7 +94,12 @@ int run(int argc, char** argv) {
   std::string out, config_path, log_path;
   uint64_t steps = 200000, seed = 1;
   int envs = 8, imitate_rollouts = 0, eval_every = 25, eval_episodes = 8;
-  app.add_option("--out", out, "policy file to write (the best evaluation so far)")->required();
+  std::string evaluate_path;
+  app.add_option("--out", out, "policy file to write (the best evaluation so far)");
+  app.add_option("--evaluate", evaluate_path,
+                 "instead of training: run this policy file and the objective selector on the "
+                 "evaluation worlds and print both")
+      ->check(CLI::ExistingFile);
   app.add_option("-c,--config", config_path,
                  "daemon configuration: the interactive space, objective, limits and costmap")
       ->check(CLI::ExistingFile);
@@ -136,6 +146,38 @@ int run(int argc, char** argv) {
   if (sigma_a >= 0) env_config.reward.sigma_a_per_index = sigma_a;
   if (tracking_distance > 0) env_config.reward.tracking_distance_m = tracking_distance;
 
+  if (out.empty() && evaluate_path.empty()) {
+    fmt::print(stderr, "--out is required (or --evaluate FILE)\n");
+    return 2;
+  }
+  const uint64_t eval_seed = 9000000;
+  auto print_eval = [](const char* who, const EvalResult& r) {
+    fmt::print(
+        "{}: return {:.0f}, contact {:.0f} % (the person {:.0f} %), lost {:.0f} %, near "
+        "obstacles {:.1f} s, q^d jumps {:.1f} per minute\n",
+        who, r.mean_return, 100 * r.contact_rate, 100 * r.person_contact_rate, 100 * r.lost_rate,
+        r.near_obstacle_s, r.jumps_per_min);
+  };
+  if (!evaluate_path.empty()) {
+    const auto n = static_cast<uint32_t>(env_config.space.points);
+    auto file = core::load_policy_file(evaluate_path, core::kObservationLayout, n,
+                                       static_cast<uint32_t>(core::observation_size(n)));
+    if (!file.policy) {
+      fmt::print(stderr, "{}: {}\n", evaluate_path, file.error);
+      return 2;
+    }
+    core::MlpPolicy policy(std::move(*file.policy));
+    print_eval("objective",
+               evaluate(env_config, eval_episodes, eval_seed,
+                        [](FollowEnv& env, auto&, auto&) { return env.objective_action(); }));
+    print_eval(evaluate_path.c_str(),
+               evaluate(env_config, eval_episodes, eval_seed,
+                        [&](FollowEnv&, std::vector<float>& obs, std::span<bool> mask) {
+                          return policy.select(obs, mask);
+                        }));
+    return 0;
+  }
+
   // Worlds: training seeds from 1 000 000 (the benchmark uses 1-50, validation 101-180);
   // evaluation worlds from 9 000 000.
   std::vector<std::unique_ptr<FollowEnvironment>> owned;
@@ -147,7 +189,6 @@ int run(int argc, char** argv) {
   }
   ppo.seed = seed;
   sim::training::PpoTrainer trainer(ppo, list);
-  const uint64_t eval_seed = 9000000;
 
   std::ofstream log;
   if (!log_path.empty()) {

@@ -213,3 +213,27 @@ TEST(FollowEnv, ThePersonLostEndsTheEpisode) {
   EXPECT_TRUE(env.last_episode().lost);
   EXPECT_EQ(steps, 16) << "0.5 s at 30 Hz, then the step past it";
 }
+
+TEST(FollowEnv, CountsTheChosenPointsJumps) {
+  // Alternating between the points ahead and behind (~2a apart) is a jump every decision after
+  // the first; neighbouring points (~0.1 m apart) and the same point are none.
+  FollowEnvConfig c = open_world();
+  c.episode_s = 1.0;  // 30 decisions
+  FollowEnv env(c, 9);
+  Buffers b(env);
+  auto run = [&](auto choose) {
+    env.reset(b.obs, b.mask());
+    for (int i = 0;; ++i) {
+      const auto r = env.step(choose(i), b.obs, b.mask());
+      if (r.terminated || r.truncated) break;
+    }
+    return env.last_episode();
+  };
+  auto free_or = [&](int i) { return b.mask()[static_cast<size_t>(i)] ? i : -1; };
+  const auto alternating = run([&](int i) { return free_or(i % 2 == 0 ? 0 : 32); });
+  EXPECT_EQ(alternating.contact, false);
+  EXPECT_GE(alternating.jumps, 25);
+  EXPECT_NEAR(alternating.duration_s, 1.0, 1e-6);
+  EXPECT_EQ(run([&](int i) { return free_or(i % 2 == 0 ? 32 : 33); }).jumps, 0);
+  EXPECT_EQ(run([&](int) { return free_or(32); }).jumps, 0);
+}

@@ -116,6 +116,8 @@ struct EpisodeStats {
       false;  // the contact was the followed person (else an obstacle or a pedestrian)
   bool lost = false;
   double near_obstacle_s = 0;  // time with r^c
+  int jumps = 0;  // the chosen point moving > 0.3 m round the ellipse from one step to the next
+  double duration_s = 0;
 };
 
 class FollowEnv {
