@@ -187,6 +187,15 @@ int run(int argc, char** argv) {
       std::cerr << "config error: " << e.to_string() << "\n";
     return 2;
   }
+  // Every trial's daemon loads a configured policy file (the selector decides whether it is
+  // used): one that does not load stops here, before any trial, not in a worker.
+  if (!loaded.config->policy.file.empty()) {
+    const auto policy = firmware::load_configured_policy(*loaded.config);
+    if (!policy.policy) {
+      std::cerr << "policy.file " << loaded.config->policy.file << ": " << policy.error << "\n";
+      return 2;
+    }
+  }
   std::vector<eval::Method> methods;
   for (const auto& name : method_names) {
     auto m = eval::method_by_name(name);
@@ -198,13 +207,7 @@ int run(int argc, char** argv) {
       std::cerr << "method 'policy' needs a policy file (policy.file in --config)\n";
       return 2;
     }
-    if (m->name == "policy") {
-      const auto policy = firmware::load_configured_policy(*loaded.config);
-      if (!policy.policy) {
-        std::cerr << "policy.file " << loaded.config->policy.file << ": " << policy.error << "\n";
-        return 2;
-      }
-    }
+
     methods.push_back(*m);
   }
   std::vector<eval::Case> cases;

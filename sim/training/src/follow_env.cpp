@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <stdexcept>
 
 #include "core/policy/observation.hpp"
 #include "firmware/daemon.hpp"
@@ -59,15 +60,8 @@ FollowEnvConfig follow_env_config(const firmware::DaemonConfig& daemon) {
   c.b_max_m = 1.25 * c.space.b_m;
   c.grid = firmware::voxel_grid_config(daemon);
   c.costmap = firmware::costmap_config(daemon);
-  c.reward.safety_clearance_m = [&] {
-    // The clearance at which the costmap reaches R (the paper's min(L) >= R).
-    double d = c.costmap.inscribed_radius_m;
-    while (d < c.costmap.inflation_radius_m &&
-           core::cost_at_distance(c.costmap, d) >= c.space.cost_threshold) {
-      d += 0.005;
-    }
-    return d;
-  }();
+  // The paper's min(L) >= R: the clearance at which the costmap reaches R.
+  c.reward.safety_clearance_m = core::distance_at_cost(c.costmap, c.space.cost_threshold);
   c.barrier_delta = daemon.dcbf.delta;
   c.max_vx_mps = daemon.limits.vx_max_mps;
   c.max_vy_mps = daemon.limits.vy_max_mps;
@@ -204,8 +198,9 @@ void FollowEnv::observe(std::span<float> observation, std::span<bool> mask) {
   in.robot_wz_radps = robot_w_;
   in.human = human_;
   in.previous_action = previous_action_;
-  std::fill(observation.begin(), observation.end(), 0.0f);
-  core::build_observation(in, observation);
+  if (!core::build_observation(in, observation)) {
+    throw std::invalid_argument("FollowEnv: the observation buffer is not observation_size()");
+  }
   const auto cs = space_.candidates();
   for (size_t i = 0; i < mask.size(); ++i)
     mask[i] = i < cs.size() && cs[i].free;

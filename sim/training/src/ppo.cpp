@@ -109,7 +109,7 @@ struct PpoTrainer::Impl {
         throw std::invalid_argument("environments differ in observation or action size");
       }
     }
-    std::vector<torch::Tensor> params = actor->parameters();
+    params = actor->parameters();
     for (const auto& p : critic->parameters())
       params.push_back(p);
     optimizer = std::make_unique<torch::optim::Adam>(
@@ -176,6 +176,7 @@ struct PpoTrainer::Impl {
   int actions;
   Mlp actor, critic;
   Standardiser scaler;
+  std::vector<torch::Tensor> params;  // the actor's and the critic's, in one optimiser
   std::unique_ptr<torch::optim::Adam> optimizer;
   double lr;
   std::mt19937_64 rng;
@@ -270,9 +271,6 @@ UpdateStats PpoTrainer::update() {
 
   UpdateStats stats;
   const int64_t batch = static_cast<int64_t>(rows) / m.config.minibatches;
-  std::vector<torch::Tensor> params = m.actor->parameters();
-  for (const auto& p : m.critic->parameters())
-    params.push_back(p);
   std::vector<int64_t> order(rows);
   for (int epoch = 0; epoch < m.config.epochs; ++epoch) {
     std::iota(order.begin(), order.end(), 0);
@@ -304,7 +302,7 @@ UpdateStats PpoTrainer::update() {
       }
       m.optimizer->zero_grad();
       loss.backward();
-      torch::nn::utils::clip_grad_norm_(params, m.config.grad_norm_clip);
+      torch::nn::utils::clip_grad_norm_(m.params, m.config.grad_norm_clip);
       m.optimizer->step();
       {
         torch::NoGradGuard no_grad;

@@ -507,3 +507,15 @@ TEST(Deskew, EachReturnUsesThePoseAtItsTime) {
 }
 
 }  // namespace
+
+TEST(Costmap, DistanceAtCostInvertsTheScale) {
+  const core::CostmapConfig c;
+  // The header's statement: R = 30 is reached at ~0.75 m.
+  EXPECT_NEAR(core::distance_at_cost(c, 30.0), 0.748, 0.001);
+  for (double cost : {10.0, 30.0, 60.0, 98.0}) {
+    const double d = core::distance_at_cost(c, cost);
+    EXPECT_NEAR(core::cost_at_distance(c, d), cost, 1e-9) << cost;
+  }
+  // Costs below the one at the inflation radius (~7.7): the radius.
+  EXPECT_DOUBLE_EQ(core::distance_at_cost(c, 1.0), c.inflation_radius_m);
+}

@@ -6,6 +6,7 @@
 //   0    free, or farther than the inflation radius from every obstacle.
 // With r_inscribed = 0.35 m and k = 3 /m, cost >= 30 (R, "unsafe") means d < 0.75 m.
 // A Costmap is a plain value: built by the lidar task, then published as an immutable snapshot.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -28,6 +29,13 @@ inline double cost_at_distance(const CostmapConfig& config, double d_m) {
   if (d_m <= config.inscribed_radius_m) return kCostLethal;
   if (d_m > config.inflation_radius_m) return 0.0;
   return 99.0 * std::exp(-config.cost_scaling_per_m * (d_m - config.inscribed_radius_m));
+}
+
+// The distance from an obstacle below which a cell's cost is at least `cost` (0 < cost < 99):
+// the inverse of cost_at_distance (R = 30 -> ~0.75 m with the defaults).
+inline double distance_at_cost(const CostmapConfig& config, double cost) {
+  const double d = config.inscribed_radius_m + std::log(99.0 / cost) / config.cost_scaling_per_m;
+  return std::min(d, config.inflation_radius_m);
 }
 
 class Costmap {
