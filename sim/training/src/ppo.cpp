@@ -113,8 +113,13 @@ struct PpoTrainer::Impl {
     for (const auto& p : critic->parameters())
       params.push_back(p);
     optimizer = std::make_unique<torch::optim::Adam>(
-        params, torch::optim::AdamOptions(config.learning_rate));
-    lr = config.learning_rate;
+        params,
+        torch::optim::AdamOptions(std::clamp(config.learning_rate, config.lr_min, config.lr_max)));
+    critic_params = critic->parameters();
+    critic_optimizer = std::make_unique<torch::optim::Adam>(
+        critic_params,
+        torch::optim::AdamOptions(std::clamp(config.learning_rate, config.lr_min, config.lr_max)));
+    lr = std::clamp(config.learning_rate, config.lr_min, config.lr_max);
     const size_t n = envs.size();
     obs.assign(n * obs_size, 0.0f);
     mask = std::make_unique<bool[]>(n * static_cast<size_t>(actions));
@@ -178,11 +183,20 @@ struct PpoTrainer::Impl {
   Standardiser scaler;
   std::vector<torch::Tensor> params;  // the actor's and the critic's, in one optimiser
   std::unique_ptr<torch::optim::Adam> optimizer;
+  // The critic's alone, while the actor is frozen (the shared optimiser's momentum would go on
+  // moving an actor it has trained, even with no gradient).
+  std::vector<torch::Tensor> critic_params;
+  std::unique_ptr<torch::optim::Adam> critic_optimizer;
   double lr;
   std::mt19937_64 rng;
   std::vector<float> obs;        // current raw observation per environment
   std::unique_ptr<bool[]> mask;  // current mask per environment
   uint64_t env_steps = 0;
+  bool actor_learning = true;
+  // Every imitation sample so far (raw observation, mask, the teacher's choice).
+  std::vector<float> bc_raw;
+  std::vector<uint8_t> bc_masks;
+  std::vector<int64_t> bc_targets;
 };
 
 PpoTrainer::PpoTrainer(const PpoConfig& config, std::vector<Environment*> envs) {
@@ -294,16 +308,19 @@ UpdateStats PpoTrainer::update() {
       const auto value = m.critic->forward(x).squeeze(1);
       const auto value_loss =
           m.config.value_loss_scale * torch::mse_loss(value, ret_t.index_select(0, idx));
-      auto loss = policy_loss + value_loss;
-      if (m.config.entropy_scale > 0) {
+      // A frozen actor gets no gradient (Adam skips it: its moments stay zero).
+      auto loss = m.actor_learning ? policy_loss + value_loss : value_loss;
+      if (m.actor_learning && m.config.entropy_scale > 0) {
         const auto p = lp_all.exp();
         const auto entropy = -(p * lp_all.clamp_min(-1e8)).sum(1).mean();
         loss = loss - m.config.entropy_scale * entropy;
       }
-      m.optimizer->zero_grad();
+      auto& optimizer = m.actor_learning ? *m.optimizer : *m.critic_optimizer;
+      optimizer.zero_grad();
       loss.backward();
-      torch::nn::utils::clip_grad_norm_(m.params, m.config.grad_norm_clip);
-      m.optimizer->step();
+      torch::nn::utils::clip_grad_norm_(m.actor_learning ? m.params : m.critic_params,
+                                        m.config.grad_norm_clip);
+      optimizer.step();
       {
         torch::NoGradGuard no_grad;
         kl_sum += ((ratio - 1) - log_ratio).mean().item<double>();
@@ -315,52 +332,75 @@ UpdateStats PpoTrainer::update() {
     // skrl's KLAdaptiveLR, once per epoch on the epoch's mean KL.
     const double kl = kl_sum / std::max(kl_count, 1);
     stats.kl = kl;
-    if (kl > 2.0 * m.config.kl_target) {
+    // (A frozen actor's KL is 0 by construction: the schedule would only raise the rate.)
+    if (m.actor_learning && kl > 2.0 * m.config.kl_target) {
       m.lr = std::max(m.config.lr_min, m.lr / m.config.lr_factor);
-    } else if (kl > 0 && kl < 0.5 * m.config.kl_target) {
+    } else if (m.actor_learning && kl > 0 && kl < 0.5 * m.config.kl_target) {
       m.lr = std::min(m.config.lr_max, m.lr * m.config.lr_factor);
     }
-    for (auto& group : m.optimizer->param_groups()) {
-      static_cast<torch::optim::AdamOptions&>(group.options()).lr(m.lr);
+    for (auto* opt : {m.optimizer.get(), m.critic_optimizer.get()}) {
+      for (auto& group : opt->param_groups()) {
+        static_cast<torch::optim::AdamOptions&>(group.options()).lr(m.lr);
+      }
     }
   }
   // The standardiser learns from this rollout for the next one (the rollout and its learning
-  // phase saw the same statistics).
-  m.scaler.add(raw.data(), rows, m.obs_size);
+  // phase saw the same statistics); not while the actor is frozen (its input would move).
+  if (m.actor_learning) m.scaler.add(raw.data(), rows, m.obs_size);
   stats.env_steps = m.env_steps;
   stats.learning_rate = m.lr;
   stats.mean_reward = reward_sum / static_cast<double>(rows);
   return stats;
 }
 
-double PpoTrainer::imitate(const std::function<int(size_t env)>& teacher, int rollouts) {
+PpoTrainer::ImitationStats PpoTrainer::imitate(const std::function<int(size_t env)>& teacher,
+                                               int rollouts, Driver driver) {
   Impl& m = *impl_;
   const size_t env_count = m.envs.size();
   const size_t action_count = static_cast<size_t>(m.actions);
-  std::vector<float> raw;
-  std::vector<uint8_t> masks;
-  std::vector<int64_t> targets;
+  const size_t first_new = m.bc_targets.size();
+  size_t agreed = 0;
+  std::vector<int> learner(env_count, -1);
+  std::vector<uint8_t> current_mask(env_count * action_count);
   for (int r = 0; r < rollouts * m.config.rollout_steps; ++r) {
+    if (driver == Driver::kLearner) {
+      torch::NoGradGuard no_grad;
+      std::copy(m.mask.get(), m.mask.get() + env_count * action_count, current_mask.begin());
+      const auto greedy = Impl::masked(m.actor->forward(m.standardise(m.obs.data(), env_count)),
+                                       m.mask_tensor(current_mask.data(), env_count))
+                              .argmax(1)
+                              .contiguous();
+      for (size_t e = 0; e < env_count; ++e)
+        learner[e] = static_cast<int>(greedy.data_ptr<int64_t>()[e]);
+    }
     for (size_t e = 0; e < env_count; ++e) {
-      const int a = teacher(e);
-      if (a >= 0) {
-        raw.insert(raw.end(), m.obs.begin() + static_cast<ptrdiff_t>(e * m.obs_size),
-                   m.obs.begin() + static_cast<ptrdiff_t>((e + 1) * m.obs_size));
-        masks.insert(masks.end(), m.mask.get() + e * action_count,
-                     m.mask.get() + (e + 1) * action_count);
-        targets.push_back(a);
+      const int label = teacher(e);
+      if (label >= 0) {
+        m.bc_raw.insert(m.bc_raw.end(), m.obs.begin() + static_cast<ptrdiff_t>(e * m.obs_size),
+                        m.obs.begin() + static_cast<ptrdiff_t>((e + 1) * m.obs_size));
+        for (size_t a = 0; a < action_count; ++a)
+          m.bc_masks.push_back(m.mask[e * action_count + a] ? 1 : 0);
+        m.bc_targets.push_back(label);
+        if (learner[e] == label) ++agreed;
       }
-      m.envs[e]->step(a, std::span<float>(&m.obs[e * m.obs_size], m.obs_size), m.mask_of(e));
+      const int act = driver == Driver::kLearner ? learner[e] : label;
+      m.envs[e]->step(act, std::span<float>(&m.obs[e * m.obs_size], m.obs_size), m.mask_of(e));
     }
   }
   m.env_steps += static_cast<uint64_t>(rollouts * m.config.rollout_steps) * env_count;
-  const size_t rows = targets.size();
-  if (rows == 0) return 0.0;
-  m.scaler.add(raw.data(), rows, m.obs_size);
-  const auto obs_all = m.standardise(raw.data(), rows);
-  const auto mask_all = m.mask_tensor(masks.data(), rows);
+  ImitationStats stats;
+  stats.samples = m.bc_targets.size();
+  stats.new_samples = stats.samples - first_new;
+  if (stats.samples == 0) return stats;
+  if (driver == Driver::kLearner && stats.new_samples > 0) {
+    stats.agreement = static_cast<double>(agreed) / static_cast<double>(stats.new_samples);
+  }
+  m.scaler.add(m.bc_raw.data() + first_new * m.obs_size, stats.new_samples, m.obs_size);
+  const size_t rows = stats.samples;
+  const auto obs_all = m.standardise(m.bc_raw.data(), rows);
+  const auto mask_all = m.mask_tensor(m.bc_masks.data(), rows);
   const auto target_all =
-      torch::from_blob(targets.data(), {static_cast<int64_t>(rows)}, torch::kInt64).clone();
+      torch::from_blob(m.bc_targets.data(), {static_cast<int64_t>(rows)}, torch::kInt64).clone();
   torch::optim::Adam opt(m.actor->parameters(), torch::optim::AdamOptions(1e-3));
   const int64_t batch = 256;
   std::vector<int64_t> order(rows);
@@ -381,7 +421,18 @@ double PpoTrainer::imitate(const std::function<int(size_t env)>& teacher, int ro
   }
   torch::NoGradGuard no_grad;
   const auto pred = Impl::masked(m.actor->forward(obs_all), mask_all).argmax(1);
-  return pred.eq(target_all).to(torch::kFloat32).mean().item<double>();
+  stats.fit_accuracy = pred.eq(target_all).to(torch::kFloat32).mean().item<double>();
+  return stats;
+}
+
+void PpoTrainer::set_actor_learning(bool on) {
+  impl_->actor_learning = on;
+}
+
+double PpoTrainer::value(std::span<const float> observation) {
+  Impl& m = *impl_;
+  torch::NoGradGuard no_grad;
+  return m.critic->forward(m.standardise(observation.data(), 1)).item<double>();
 }
 
 std::vector<float> PpoTrainer::logits(std::span<const float> observation) {

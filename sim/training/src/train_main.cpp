@@ -109,6 +109,14 @@ int run(int argc, char** argv) {
   app.add_option("--imitate-rollouts", imitate_rollouts,
                  "warm start: rollouts of the objective selector to imitate first (0: none, "
                  "the paper's from-scratch PPO)");
+  int dagger_rounds = 0, critic_warmup = 0;
+  app.add_option("--dagger-rounds", dagger_rounds,
+                 "after the warm start: rounds of DAgger (the learner drives, the objective "
+                 "labels; --imitate-rollouts rollouts each)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--critic-warmup", critic_warmup,
+                 "first PPO updates that train the critic only (the warm-started actor frozen)")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--eval-every", eval_every, "updates between evaluations")
       ->check(CLI::PositiveNumber);
   app.add_option("--eval-episodes", eval_episodes, "episodes per evaluation (fixed worlds)")
@@ -127,6 +135,8 @@ int run(int argc, char** argv) {
                  "entropy bonus (skrl's default 0; a deterministic policy then has KL 0 and "
                  "the KL-adaptive schedule raises the rate to lr_max)")
       ->check(CLI::NonNegativeNumber);
+  app.add_option("--lr", ppo.learning_rate, "the first learning rate (skrl: 1e-3)")
+      ->check(CLI::PositiveNumber);
   app.add_option("--lr-max", ppo.lr_max, "the KL-adaptive schedule's ceiling (skrl: 1e-2)")
       ->check(CLI::PositiveNumber);
   app.add_option("--rollout-steps", ppo.rollout_steps,
@@ -198,7 +208,8 @@ int run(int argc, char** argv) {
       return 2;
     }
     log << "update,env_steps,wall_s,learning_rate,kl,mean_reward,eval_return,"
-           "eval_contact_rate,eval_person_contact_rate,eval_lost_rate,eval_near_obstacle_s\n";
+           "eval_contact_rate,eval_person_contact_rate,eval_lost_rate,eval_near_obstacle_s,"
+           "eval_jumps_per_min\n";
   }
   const auto t0 = std::chrono::steady_clock::now();
   auto wall = [&] {
@@ -213,13 +224,6 @@ int run(int argc, char** argv) {
       "{:.0f} %), lost {:.0f} %, near obstacles {:.1f} s\n",
       eval_episodes, baseline.mean_return, 100 * baseline.contact_rate,
       100 * baseline.person_contact_rate, 100 * baseline.lost_rate, baseline.near_obstacle_s);
-  if (imitate_rollouts > 0) {
-    const double acc = trainer.imitate([&](size_t e) { return owned[e]->env.objective_action(); },
-                                       imitate_rollouts);
-    fmt::print("imitation of the objective selector: {:.1f} % of its choices ({:.0f} s)\n",
-               100 * acc, wall());
-  }
-
   auto greedy = [&](FollowEnv&, std::vector<float>& obs, std::span<bool> mask) {
     return trainer.act_greedy(obs, mask);
   };
@@ -232,12 +236,33 @@ int run(int argc, char** argv) {
     fmt::print("  wrote {} (update {}, evaluation return {:.0f})\n", out, update, score);
   };
 
+  if (imitate_rollouts > 0) {
+    const auto teacher = [&](size_t e) { return owned[e]->env.objective_action(); };
+    for (int round = 0; round <= dagger_rounds; ++round) {
+      using Driver = sim::training::PpoTrainer::Driver;
+      const auto st = trainer.imitate(teacher, imitate_rollouts,
+                                      round == 0 ? Driver::kTeacher : Driver::kLearner);
+      fmt::print(
+          "imitation round {} ({}): {} samples, the learner chose the objective's point in {:.1f} "
+          "% of its own states before the fit, {:.1f} % of all after ({:.0f} s)\n",
+          round, round == 0 ? "behaviour cloning" : "DAgger", st.samples, 100 * st.agreement,
+          100 * st.fit_accuracy, wall());
+    }
+    // The warm-started policy is a candidate too: PPO's checkpoints replace it only by doing
+    // better on the evaluation worlds.
+    const EvalResult r = evaluate(env_config, eval_episodes, eval_seed, greedy);
+    print_eval("imitation", r);
+    save(r.mean_return, 0);
+  }
+  trainer.set_actor_learning(critic_warmup <= 0);
+
   int update = 0;
   uint64_t done_steps = 0;
   while (done_steps < steps) {
     const auto s = trainer.update();
     done_steps = s.env_steps;
     ++update;
+    if (update == critic_warmup) trainer.set_actor_learning(true);
     if (update % eval_every == 0 || done_steps >= steps) {
       const EvalResult r = evaluate(env_config, eval_episodes, eval_seed, greedy);
       fmt::print(
@@ -249,10 +274,11 @@ int run(int argc, char** argv) {
           100 * r.lost_rate);
       std::fflush(stdout);  // NOLINT(cert-err33-c): progress lines, nothing to do on failure
       if (log.is_open()) {
-        log << fmt::format("{},{},{:.1f},{:.3g},{:.5f},{:.3f},{:.1f},{:.3f},{:.3f},{:.3f},{:.2f}\n",
-                           update, done_steps, wall(), s.learning_rate, s.kl, s.mean_reward,
-                           r.mean_return, r.contact_rate, r.person_contact_rate, r.lost_rate,
-                           r.near_obstacle_s)
+        log << fmt::format(
+                   "{},{},{:.1f},{:.3g},{:.5f},{:.3f},{:.1f},{:.3f},{:.3f},{:.3f},{:.2f},{:.1f}\n",
+                   update, done_steps, wall(), s.learning_rate, s.kl, s.mean_reward, r.mean_return,
+                   r.contact_rate, r.person_contact_rate, r.lost_rate, r.near_obstacle_s,
+                   r.jumps_per_min)
             << std::flush;
       }
       save(r.mean_return, update);

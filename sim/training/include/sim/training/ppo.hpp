@@ -79,9 +79,25 @@ class PpoTrainer {
 
   // One rollout and one learning phase.
   UpdateStats update();
-  // Supervised warm start (optional): cross-entropy of the masked actor toward `teacher`'s choice
-  // on observations gathered by acting with the teacher; also fits the standardiser.
-  double imitate(const std::function<int(size_t env)>& teacher, int rollouts);
+  // Supervised warm start (optional): `rollouts` rollouts labelled with `teacher`'s choice, then
+  // the masked actor refit (cross-entropy) on every sample gathered so far. Who acts:
+  // `kTeacher` (behaviour cloning: the teacher's own states) or `kLearner` (DAgger, Ross et al.
+  // 2011: the learner's greedy choices drive the environments, so it also learns what the
+  // teacher would do in the states its own mistakes lead to). The standardiser fits every
+  // sample too.
+  enum class Driver { kTeacher, kLearner };
+  struct ImitationStats {
+    size_t new_samples = 0, samples = 0;
+    double agreement = 0;     // of the new samples: the learner's greedy choice was the teacher's
+                              // (before this refit; the on-policy match DAgger improves)
+    double fit_accuracy = 0;  // on every sample, after the refit
+  };
+  ImitationStats imitate(const std::function<int(size_t env)>& teacher, int rollouts,
+                         Driver driver = Driver::kTeacher);
+  // Off: updates train the critic only; the actor, the standardiser and the learning-rate
+  // schedule (which reads the actor's KL) stay as they are: a warm-started actor keeps its
+  // choices while the value function catches up with it.
+  void set_actor_learning(bool on);
 
   // The greedy (masked argmax) choice for one raw observation.
   int act_greedy(std::span<const float> observation, std::span<const bool> mask);
@@ -89,6 +105,8 @@ class PpoTrainer {
   [[nodiscard]] core::PolicyFile export_policy(uint32_t layout_id) const;
   // Raw logits of the actor (tests compare them with core::MlpPolicy on the exported file).
   std::vector<float> logits(std::span<const float> observation);
+  // The critic's value of one raw observation (in reward_scale units).
+  double value(std::span<const float> observation);
 
  private:
   struct Impl;
