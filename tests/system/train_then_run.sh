@@ -10,6 +10,12 @@ trap 'rm -rf "$work"' EXIT
 "$train" --out "$work/p.bin" --steps 256 --envs 2 --eval-every 4 --eval-episodes 1 --log "$work/t.csv" > "$work/train.log"
 test -s "$work/p.bin"
 grep -q '^8,256,' "$work/t.csv"
+# The warm start alone (--steps 0): behaviour cloning, one DAgger round, the imitated policy
+# evaluated and written as the file.
+"$train" --out "$work/w.bin" --steps 0 --envs 2 --imitate-rollouts 1 --dagger-rounds 1 --eval-episodes 1 > "$work/warm.log"
+grep -q 'imitation round 1 (DAgger): 64 samples' "$work/warm.log"
+grep -q "wrote $work/w.bin (update 0" "$work/warm.log"
+test -s "$work/w.bin"
 sed "s|^  file: \"\"|  file: \"$work/p.bin\"|" "$config" > "$work/policy.yaml"
 grep -q "file: \"$work/p.bin\"" "$work/policy.yaml"
 "$eval" --case open --method policy --duration-s 6 --jobs 1 -c "$work/policy.yaml" --out "$work/eval" > "$work/eval.log"

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <memory>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "core/policy/observation.hpp"
@@ -242,10 +243,16 @@ int run(int argc, char** argv) {
       using Driver = sim::training::PpoTrainer::Driver;
       const auto st = trainer.imitate(teacher, imitate_rollouts,
                                       round == 0 ? Driver::kTeacher : Driver::kLearner);
+      const std::string agreement =
+          round == 0 ? std::string("the objective drove")
+                     : fmt::format(
+                           "the learner chose the objective's point in {:.1f} % of its "
+                           "own states before the fit",
+                           100 * st.agreement);
       fmt::print(
-          "imitation round {} ({}): {} samples, the learner chose the objective's point in {:.1f} "
-          "% of its own states before the fit, {:.1f} % of all after ({:.0f} s)\n",
-          round, round == 0 ? "behaviour cloning" : "DAgger", st.samples, 100 * st.agreement,
+          "imitation round {} ({}): {} samples, {}, {:.1f} % of all after the fit ({:.0f} "
+          "s)\n",
+          round, round == 0 ? "behaviour cloning" : "DAgger", st.samples, agreement,
           100 * st.fit_accuracy, wall());
     }
     // The warm-started policy is a candidate too: PPO's checkpoints replace it only by doing
