@@ -16,6 +16,10 @@ grep -q '^8,256,' "$work/t.csv"
 grep -q 'imitation round 1 (DAgger): 64 samples' "$work/warm.log"
 grep -q "wrote $work/w.bin (update 0" "$work/warm.log"
 test -s "$work/w.bin"
+if "$train" --out "$work/x.bin" --steps 0 --dagger-rounds 1 > "$work/x.log" 2>&1; then
+  echo "companion-train accepted DAgger rounds without imitation rollouts"; exit 1
+fi
+grep -q -- "--dagger-rounds needs --imitate-rollouts" "$work/x.log"
 sed "s|^  file: \"\"|  file: \"$work/p.bin\"|" "$config" > "$work/policy.yaml"
 grep -q "file: \"$work/p.bin\"" "$work/policy.yaml"
 "$eval" --case open --method policy --duration-s 6 --jobs 1 -c "$work/policy.yaml" --out "$work/eval" > "$work/eval.log"

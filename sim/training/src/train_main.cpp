@@ -157,6 +157,10 @@ int run(int argc, char** argv) {
   if (sigma_a >= 0) env_config.reward.sigma_a_per_index = sigma_a;
   if (tracking_distance > 0) env_config.reward.tracking_distance_m = tracking_distance;
 
+  if (dagger_rounds > 0 && imitate_rollouts <= 0) {
+    fmt::print(stderr, "--dagger-rounds needs --imitate-rollouts (the rollouts of each round)\n");
+    return 2;
+  }
   if (out.empty() && evaluate_path.empty()) {
     fmt::print(stderr, "--out is required (or --evaluate FILE)\n");
     return 2;
