@@ -207,7 +207,6 @@ int run(int argc, char** argv) {
       std::cerr << "method 'policy' needs a policy file (policy.file in --config)\n";
       return 2;
     }
-
     methods.push_back(*m);
   }
   std::vector<eval::Case> cases;

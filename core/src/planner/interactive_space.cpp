@@ -38,7 +38,7 @@ void InteractiveSpace::update(const Pose2& person_base, const Pose2& robot_odom,
   free_count_ = 0;
   for (size_t i = 0; i < candidates_.size(); ++i) {
     Candidate& c = candidates_[i];
-    const Point2 p = person_base.apply({config_.a_m * cos_phi_[i], config_.b_m * sin_phi_[i]});
+    const Point2 p = person_base.apply(point_in_person(i));
     c.base = Pose2{p.x_m, p.y_m, person_base.theta_rad};
     c.odom = robot_odom.apply(p);
     c.dist_human_m = std::hypot(p.x_m - person_base.x_m, p.y_m - person_base.y_m);

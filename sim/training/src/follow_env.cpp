@@ -27,6 +27,8 @@ core::Nanos nanos(double t_s) {
 
 // Simulated seconds between physics steps inside one policy period (the control task's rate).
 constexpr double kPhysicsStepS = 0.01;
+// A change of the chosen point farther than this round W is a "jump" (EpisodeStats::jumps).
+constexpr double kJumpM = 0.3;
 
 }  // namespace
 
@@ -313,14 +315,11 @@ StepResult FollowEnv::step(int action, std::span<float> observation, std::span<b
                    previous_action_, config_.space.points, obstacle_clearance_m(), contact);
   if (previous_action_ >= 0 && result.action_taken >= 0 &&
       previous_action_ != result.action_taken) {
-    // The distance between the two points of W in the person's frame (companion-eval's
-    // "q^d jumps" counts the same in the closed loop's samples).
-    const auto point = [&](int i) {
-      const double phi = 2.0 * std::numbers::pi * i / config_.space.points;
-      return core::Point2{space_.config().a_m * std::cos(phi), space_.config().b_m * std::sin(phi)};
-    };
-    const core::Point2 p = point(previous_action_), q = point(result.action_taken);
-    if (std::hypot(p.x_m - q.x_m, p.y_m - q.y_m) > 0.3) ++episode_.jumps;
+    // The distance between the two points of W in the person's frame (docs/EVALUATION.md counts
+    // the same in the closed loop's samples).
+    const core::Point2 p = space_.point_in_person(static_cast<size_t>(previous_action_));
+    const core::Point2 q = space_.point_in_person(static_cast<size_t>(result.action_taken));
+    if (std::hypot(p.x_m - q.x_m, p.y_m - q.y_m) > kJumpM) ++episode_.jumps;
   }
   previous_distance_m_ = distance;
   previous_action_ = result.action_taken;

@@ -112,14 +112,11 @@ struct PpoTrainer::Impl {
     params = actor->parameters();
     for (const auto& p : critic->parameters())
       params.push_back(p);
-    optimizer = std::make_unique<torch::optim::Adam>(
-        params,
-        torch::optim::AdamOptions(std::clamp(config.learning_rate, config.lr_min, config.lr_max)));
-    critic_params = critic->parameters();
-    critic_optimizer = std::make_unique<torch::optim::Adam>(
-        critic_params,
-        torch::optim::AdamOptions(std::clamp(config.learning_rate, config.lr_min, config.lr_max)));
     lr = std::clamp(config.learning_rate, config.lr_min, config.lr_max);
+    optimizer = std::make_unique<torch::optim::Adam>(params, torch::optim::AdamOptions(lr));
+    critic_params = critic->parameters();
+    critic_optimizer =
+        std::make_unique<torch::optim::Adam>(critic_params, torch::optim::AdamOptions(lr));
     const size_t n = envs.size();
     obs.assign(n * obs_size, 0.0f);
     mask = std::make_unique<bool[]>(n * static_cast<size_t>(actions));
@@ -222,7 +219,6 @@ UpdateStats PpoTrainer::update() {
   std::vector<float> logp(rows), values(rows), rewards(rows),
       last_values(static_cast<size_t>(env_count));
   std::vector<uint8_t> done(rows);
-  torch::Tensor obs_t;
   double reward_sum = 0;
   {
     torch::NoGradGuard no_grad;
@@ -308,7 +304,7 @@ UpdateStats PpoTrainer::update() {
       const auto value = m.critic->forward(x).squeeze(1);
       const auto value_loss =
           m.config.value_loss_scale * torch::mse_loss(value, ret_t.index_select(0, idx));
-      // A frozen actor gets no gradient (Adam skips it: its moments stay zero).
+      // A frozen actor: the critic's loss alone, stepped by the critic's own optimiser.
       auto loss = m.actor_learning ? policy_loss + value_loss : value_loss;
       if (m.actor_learning && m.config.entropy_scale > 0) {
         const auto p = lp_all.exp();

@@ -48,6 +48,10 @@ TEST(InteractiveSpace, PointsLieOnTheEllipseAroundThePersonInBaseLink) {
   EXPECT_NEAR(c[1].base.x_m, 1.3, 1e-12);
   EXPECT_NEAR(c[1].base.y_m, 0.0, 1e-12);
   EXPECT_NEAR(c[2].base.y_m, -1.0, 1e-12);
+  // The same points in the person's frame, whatever the person's pose.
+  EXPECT_NEAR(w.point_in_person(0).x_m, 1.0, 1e-12);
+  EXPECT_NEAR(w.point_in_person(1).y_m, 0.7, 1e-12);
+  EXPECT_NEAR(w.point_in_person(2).x_m, -1.0, 1e-12);
   for (const auto& p : c) {
     EXPECT_NEAR(p.base.theta_rad, pi / 2, 1e-12) << "desired heading = the person's";
     EXPECT_TRUE(p.free);

@@ -51,6 +51,10 @@ class InteractiveSpace {
   [[nodiscard]] std::span<const Candidate> candidates() const { return candidates_; }
   [[nodiscard]] size_t free_count() const { return free_count_; }
   [[nodiscard]] const InteractiveSpaceConfig& config() const { return config_; }
+  // Point i of W in the person's frame (x along their heading): (a cos phi_i, b sin phi_i).
+  [[nodiscard]] Point2 point_in_person(size_t i) const {
+    return {config_.a_m * cos_phi_[i], config_.b_m * sin_phi_[i]};
+  }
 
  private:
   InteractiveSpaceConfig config_;
