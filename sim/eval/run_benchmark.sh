@@ -12,8 +12,9 @@
 # default 10), METHODS (default objective,fixed_behind,fixed_side,pid; add policy with a policy
 # file in CONFIG), CONFIG (a daemon configuration for every trial, default: built-in defaults),
 # DURATION_S (cut every trial to this long: CI's reduced run), JOBS (trials in parallel), STEPS
-# (default "paper variants recorded": run a subset again; the report takes every step's latest
-# results found in OUT).
+# (default "paper variants recorded"; variants = "crowds speeds sizes constrained": run a subset,
+# e.g. one per sitting of a run longer than a working session; the report takes every step's
+# latest results found in OUT).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 out=${1:-eval-full}
@@ -30,6 +31,17 @@ if [[ ! -x "$eval_bin" ]]; then
   exit 2
 fi
 steps=${STEPS:-paper variants recorded}
+steps=${steps//variants/crowds speeds sizes constrained}
+dirs=(paper crowds speeds sizes constrained recorded-biwi_hotel recorded-crowds_zara01)
+for step in $steps; do  # checked before anything runs: a typo must not cost an hour's run first
+  case $step in
+    paper | crowds | speeds | sizes | constrained | recorded) ;;
+    *)
+      echo "run_benchmark: unknown step '$step' (paper, variants, crowds, speeds, sizes, constrained, recorded)" >&2
+      exit 2
+      ;;
+  esac
+done
 mkdir -p "$out"
 run() {  # one companion-eval run into $out/$1, its console output kept in $out/$1.log
   local name=$1
@@ -40,24 +52,24 @@ run() {  # one companion-eval run into $out/$1, its console output kept in $out/
 for step in $steps; do
   case $step in
     paper) run paper --case paper --trials "$trials" --samples ;;
-    variants) run variants --case crowds speeds sizes constrained --trials "$variant_trials" ;;
+    crowds | speeds | sizes | constrained) run "$step" --case "$step" --trials "$variant_trials" ;;
     recorded)
       for f in biwi_hotel crowds_zara01; do
         run "recorded-$f" --pedestrians "sim/data/pedestrians/$f.txt" --frame-period 0.4 --samples
       done
       ;;
-    *)
-      echo "run_benchmark: unknown step '$step' (paper, variants, recorded)" >&2
-      exit 2
-      ;;
   esac
 done
-for d in paper variants recorded-biwi_hotel recorded-crowds_zara01; do
+for d in "${dirs[@]}"; do
   if [[ -d "$out/$d" ]]; then /usr/bin/python3 sim/eval/plot_eval.py "$out/$d" >/dev/null; fi
 done
 
 # Totals from the runs' own summaries ("N trials in S s"): steps may have run separately.
-read -r total seconds < <(cat "$out"/*/summary.md | awk '/ trials in [0-9]+ s / {
+summaries=()
+for d in "${dirs[@]}"; do
+  if [[ -f "$out/$d/summary.md" ]]; then summaries+=("$out/$d/summary.md"); fi
+done
+read -r total seconds < <(cat "${summaries[@]}" /dev/null | awk '/ trials in [0-9]+ s / {
   n += $1; s += $4 } END { print n + 0, s + 0 }')
 {
   echo "# companion-eval: the full benchmark"
@@ -68,7 +80,7 @@ read -r total seconds < <(cat "$out"/*/summary.md | awk '/ trials in [0-9]+ s / 
   echo
   echo "$total trials in $seconds s of wall time on $(nproc) cores:" \
     "$(awk -v n="$total" -v s="$seconds" 'BEGIN { printf "%.1f", (s > 0 ? 60 * n / s : 0) }') trials/min."
-  for d in paper variants recorded-biwi_hotel recorded-crowds_zara01; do
+  for d in "${dirs[@]}"; do
     [[ -f "$out/$d/summary.md" ]] || continue
     echo
     echo "# $d"

@@ -69,21 +69,46 @@ TEST(CompanionEval, TheOneCommandBenchmarkWritesEveryTableAndPlot) {
   ASSERT_EQ(p.wait(900s), 0) << p.output();
   const std::string report = slurp(out + "/REPORT.md");
   for (const char* expected :
-       {"trials/min", "# paper", "## open (1 trial per method)", "## random (1 trial per method)",
-        "# variants", "## crowd-20 (1 trial per method)", "## speed-1.7 (1 trial per method)",
-        "## size-1.2x0.9 (1 trial per method)", "## clutter-0.8 (1 trial per method)",
-        "## dead_end (1 trial per method)", "## crowd density", "| objective | 15 | 1 |",
-        "# recorded-biwi_hotel", "# recorded-crowds_zara01", "| failures |"}) {
+       {"trials/min", "\n# paper\n", "## open (1 trial per method)",
+        "## random (1 trial per method)", "\n# crowds\n", "## crowd-20 (1 trial per method)",
+        "\n# speeds\n", "## speed-1.7 (1 trial per method)", "\n# sizes\n",
+        "## size-1.2x0.9 (1 trial per method)", "\n# constrained\n",
+        "## clutter-0.8 (1 trial per method)", "## dead_end (1 trial per method)",
+        "## crowd density", "| objective | 15 | 1 |", "# recorded-biwi_hotel",
+        "# recorded-crowds_zara01", "| failures |"}) {
     EXPECT_NE(report.find(expected), std::string::npos) << expected << "\n" << report;
   }
   // 7 paper cases + 14 variants (the dead end among them) + 2 recorded.
   EXPECT_NE(report.find("23 trials in"), std::string::npos) << report;
   for (const char* f : {"/paper/plots/sides-random.png", "/paper/plots/trajectories-doorway.png",
-                        "/variants/plots/sr-crowds.png", "/variants/plots/sr-speeds.png",
-                        "/variants/plots/sr-sizes.png", "/variants/plots/sr-constrained.png",
+                        "/crowds/plots/sr-crowds.png", "/speeds/plots/sr-speeds.png",
+                        "/sizes/plots/sr-sizes.png", "/constrained/plots/sr-constrained.png",
                         "/recorded-biwi_hotel/plots/trajectories-recorded.png"}) {
     EXPECT_GT(slurp(out + f).size(), 1000U) << f;
   }
+}
+
+TEST(CompanionEval, TheBenchmarkCanRunInSittingsIntoOneReport) {
+  // A full run is longer than a working session: STEPS runs groups one at a time into the same
+  // OUT, and the report gathers every group found there.
+  const std::string out = ::testing::TempDir() + "companion-benchmark-sittings";
+  for (const char* steps : {"STEPS=sizes", "STEPS=speeds"}) {
+    ChildProcess p({"/usr/bin/env", "EVAL=" COMPANION_EVAL_PATH, "VARIANT_TRIALS=1",
+                    "METHODS=objective", "DURATION_S=1", "JOBS=2", steps, "bash",
+                    COMPANION_BENCHMARK_SCRIPT, out});
+    ASSERT_TRUE(p.started());
+    ASSERT_EQ(p.wait(300s), 0) << p.output();
+  }
+  const std::string report = slurp(out + "/REPORT.md");
+  EXPECT_NE(report.find("\n# sizes\n"), std::string::npos) << report;
+  EXPECT_NE(report.find("\n# speeds\n"), std::string::npos) << report;
+  EXPECT_EQ(report.find("\n# crowds\n"), std::string::npos) << report;
+  EXPECT_NE(report.find("6 trials in"), std::string::npos) << report;  // 3 sizes + 3 speeds
+  ChildProcess bad({"/usr/bin/env", "EVAL=" COMPANION_EVAL_PATH, "STEPS=moon", "bash",
+                    COMPANION_BENCHMARK_SCRIPT, out});
+  ASSERT_TRUE(bad.started());
+  EXPECT_EQ(bad.wait(30s), 2);
+  EXPECT_NE(bad.output().find("unknown step 'moon'"), std::string::npos) << bad.output();
 }
 
 TEST(CompanionEval, FollowsARecordedPersonFromAnyDatasetFile) {
