@@ -264,6 +264,9 @@ int run(int argc, char** argv) {
   std::string iface = "can0";
   dump->add_flag("--candump", dump_candump, "candump -l format (canplayer/log2asc read it)");
   dump->add_option("--seconds", dump_s, "stop after this long (0: until Ctrl-C)");
+  int64_t dump_count = 0;
+  dump->add_option("--count", dump_count, "stop after this many frames (candump -n; 0: no limit)")
+      ->check(CLI::Range(int64_t{0}, int64_t{1000000000}));
   dump->add_option("--iface", iface, "interface name written in candump lines");
 
   auto* replay = app.add_subcommand("replay", "send a candump log with its original timing");
@@ -389,8 +392,13 @@ int run(int argc, char** argv) {
             ? clock.now() + std::chrono::duration_cast<Nanos>(std::chrono::duration<double>(dump_s))
             : Nanos::max();
     hal::LinuxClock sleeper;
-    while (!firmware::tool::interrupted() && clock.now() < end) {
-      while (auto rx = bus.receive()) {
+    int64_t frames = 0;
+    auto more = [&] { return dump_count == 0 || frames < dump_count; };
+    while (!firmware::tool::interrupted() && clock.now() < end && more()) {
+      while (more()) {
+        auto rx = bus.receive();
+        if (!rx) break;
+        ++frames;
         if (dump_candump) {
           timespec rt{};
           clock_gettime(CLOCK_REALTIME, &rt);
