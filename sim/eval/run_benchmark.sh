@@ -33,14 +33,12 @@ fi
 steps=${STEPS:-paper variants recorded}
 steps=${steps//variants/crowds speeds sizes constrained}
 dirs=(paper crowds speeds sizes constrained recorded-biwi_hotel recorded-crowds_zara01)
+known="paper crowds speeds sizes constrained recorded"
 for step in $steps; do  # checked before anything runs: a typo must not cost an hour's run first
-  case $step in
-    paper | crowds | speeds | sizes | constrained | recorded) ;;
-    *)
-      echo "run_benchmark: unknown step '$step' (paper, variants, crowds, speeds, sizes, constrained, recorded)" >&2
-      exit 2
-      ;;
-  esac
+  if [[ " $known " != *" $step "* ]]; then
+    echo "run_benchmark: unknown step '$step' (variants or one of: $known)" >&2
+    exit 2
+  fi
 done
 mkdir -p "$out"
 run() {  # one companion-eval run into $out/$1, its console output kept in $out/$1.log
@@ -75,7 +73,7 @@ read -r total seconds < <(cat "${summaries[@]}" /dev/null | awk '/ trials in [0-
   echo "# companion-eval: the full benchmark"
   echo
   echo "Command: \`sim/eval/run_benchmark.sh $out\` (TRIALS=$trials, VARIANT_TRIALS=$variant_trials,"
-  echo "METHODS=$methods${CONFIG:+, CONFIG=$CONFIG}${DURATION_S:+, DURATION_S=$DURATION_S}), $(date -u +%Y-%m-%d)," \
+  echo "METHODS=$methods${CONFIG:+, CONFIG=$CONFIG}${DURATION_S:+, DURATION_S=$DURATION_S}${STEPS:+; the last sitting STEPS=$STEPS, the report gathers every step found in OUT}), $(date -u +%Y-%m-%d)," \
     "commit $(git rev-parse --short HEAD 2>/dev/null || echo '?')."
   echo
   echo "$total trials in $seconds s of wall time on $(nproc) cores:" \
