@@ -173,6 +173,7 @@ int run(int argc, char** argv) {
         who, r.mean_return, 100 * r.contact_rate, 100 * r.person_contact_rate, 100 * r.lost_rate,
         r.near_obstacle_s, r.jumps_per_min);
   };
+  const auto objective = [](FollowEnv& env, auto&, auto&) { return env.objective_action(); };
   if (!evaluate_path.empty()) {
     const auto n = static_cast<uint32_t>(env_config.space.points);
     auto file = core::load_policy_file(evaluate_path, core::kObservationLayout, n,
@@ -182,9 +183,7 @@ int run(int argc, char** argv) {
       return 2;
     }
     core::MlpPolicy policy(std::move(*file.policy));
-    print_eval("objective",
-               evaluate(env_config, eval_episodes, eval_seed,
-                        [](FollowEnv& env, auto&, auto&) { return env.objective_action(); }));
+    print_eval("objective", evaluate(env_config, eval_episodes, eval_seed, objective));
     print_eval(evaluate_path.c_str(),
                evaluate(env_config, eval_episodes, eval_seed,
                         [&](FollowEnv&, std::vector<float>& obs, std::span<bool> mask) {
@@ -221,9 +220,7 @@ int run(int argc, char** argv) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   };
 
-  const EvalResult baseline =
-      evaluate(env_config, eval_episodes, eval_seed,
-               [](FollowEnv& env, auto&, auto&) { return env.objective_action(); });
+  const EvalResult baseline = evaluate(env_config, eval_episodes, eval_seed, objective);
   fmt::print(
       "objective selector on {} evaluation worlds: return {:.0f}, contact {:.0f} % (the person "
       "{:.0f} %), lost {:.0f} %, near obstacles {:.1f} s\n",
