@@ -2,20 +2,33 @@
 # The learned selector's whole path: companion-train writes a policy file (a few hundred
 # decisions: the pipeline, not a useful policy), companiond's configuration names it, and
 # companion-eval's closed loop runs the daemon with it (the file loads, the policy task chooses).
-# Usage: train_then_run.sh COMPANION_TRAIN COMPANION_EVAL CONFIG_YAML
+# With --checkpoints every candidate is kept, and validate_policies.sh runs them through
+# companion-eval's closed loop and keeps the best.
+# Usage: train_then_run.sh COMPANION_TRAIN COMPANION_EVAL CONFIG_YAML VALIDATE_POLICIES_SH
 set -euo pipefail
-train=$1 eval=$2 config=$3
+train=$1 eval=$2 config=$3 validate=$4
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 "$train" --out "$work/p.bin" --steps 256 --envs 2 --eval-every 4 --eval-episodes 1 --log "$work/t.csv" > "$work/train.log"
 test -s "$work/p.bin"
 grep -q '^8,256,' "$work/t.csv"
-# The warm start alone (--steps 0): behaviour cloning, one DAgger round, the imitated policy
-# evaluated and written as the file.
-"$train" --out "$work/w.bin" --steps 0 --envs 2 --imitate-rollouts 1 --dagger-rounds 1 --eval-episodes 1 > "$work/warm.log"
+# The warm start (behaviour cloning, one DAgger round; the imitated policy evaluated and written
+# as the file) and PPO to 256 steps (the imitation's 64 among them: updates 2, 4, 6), every
+# candidate kept (--checkpoints).
+"$train" --out "$work/w.bin" --steps 256 --envs 2 --imitate-rollouts 1 --dagger-rounds 1 --eval-every 2 --eval-episodes 1 --checkpoints "$work/ck" > "$work/warm.log"
 grep -q 'imitation round 1 (DAgger): 64 samples' "$work/warm.log"
 grep -q "wrote $work/w.bin (update 0" "$work/warm.log"
 test -s "$work/w.bin"
+for c in imitation-0 imitation-1 update-00002 update-00004 update-00006; do test -s "$work/ck/$c.bin"; done
+if cmp -s "$work/ck/imitation-0.bin" "$work/ck/imitation-1.bin"; then
+  echo "the DAgger round's checkpoint is the behaviour cloning's"; exit 1
+fi
+env EVAL="$eval" TRIALS=1 DURATION_S=3 JOBS=1 CONFIG="$config" bash "$validate" "$work/val" "$work/ck/imitation-1.bin" "$work/ck/update-00006.bin" > "$work/val.log"
+grep -q '^| objective | 1 / 1 |' "$work/val/VALIDATION.md"
+grep -q '^| imitation-1 | 1 / 1 |' "$work/val/VALIDATION.md"
+grep -q '^| update-00006 | 1 / 1 |' "$work/val/VALIDATION.md"
+test -s "$work/val/best.bin"
+grep -q "^  file: \"$(realpath "$work/ck/update-00006.bin")\"" "$work/val/update-00006.yaml"
 if "$train" --out "$work/x.bin" --steps 0 --dagger-rounds 1 > "$work/x.log" 2>&1; then
   echo "companion-train accepted DAgger rounds without imitation rollouts"; exit 1
 fi

@@ -123,6 +123,11 @@ int run(int argc, char** argv) {
   app.add_option("--eval-episodes", eval_episodes, "episodes per evaluation (fixed worlds)")
       ->check(CLI::PositiveNumber);
   app.add_option("--log", log_path, "CSV of the training (one row per evaluation)");
+  std::string checkpoints;
+  app.add_option("--checkpoints", checkpoints,
+                 "also write every candidate here (imitation-R.bin after each imitation round, "
+                 "update-U.bin at each evaluation) for a choice by closed-loop trials "
+                 "(sim/eval/validate_policies.sh)");
   double sigma_h = -1, sigma_a = -1, tracking_distance = -1;
   app.add_option("--sigma-h", sigma_h, "r^h weight per metre closed (default 100)")
       ->check(CLI::NonNegativeNumber);
@@ -164,6 +169,15 @@ int run(int argc, char** argv) {
   if (out.empty() && evaluate_path.empty()) {
     fmt::print(stderr, "--out is required (or --evaluate FILE)\n");
     return 2;
+  }
+  if (!checkpoints.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(checkpoints, ec);
+    if (ec || !std::filesystem::is_directory(checkpoints)) {
+      fmt::print(stderr, "--checkpoints {}: cannot make the directory ({})\n", checkpoints,
+                 ec.message());
+      return 2;
+    }
   }
   const uint64_t eval_seed = 9000000;
   auto print_eval = [](const char* who, const EvalResult& r) {
@@ -229,12 +243,23 @@ int run(int argc, char** argv) {
   auto greedy = [&](FollowEnv&, std::vector<float>& obs, std::span<bool> mask) {
     return trainer.act_greedy(obs, mask);
   };
+  // The training return chooses --out; the checkpoints let closed-loop trials choose instead
+  // (the return is not what the benchmark counts: twelfth version, docs/EVALUATION.md).
+  auto policy_bytes = [&] {
+    return core::encode_policy(trainer.export_policy(core::kObservationLayout));
+  };
+  auto checkpoint = [&](const std::string& name) {
+    if (checkpoints.empty()) return;
+    const auto path = (std::filesystem::path(checkpoints) / (name + ".bin")).string();
+    if (!write_policy(path, policy_bytes()))
+      throw std::runtime_error("cannot write the checkpoint " + path);
+  };
   double best = -1e300;
   auto save = [&](double score, int update) {
     if (score <= best) return;
     best = score;
-    const auto bytes = core::encode_policy(trainer.export_policy(core::kObservationLayout));
-    if (!write_policy(out, bytes)) throw std::runtime_error("cannot write the policy file " + out);
+    if (!write_policy(out, policy_bytes()))
+      throw std::runtime_error("cannot write the policy file " + out);
     fmt::print("  wrote {} (update {}, evaluation return {:.0f})\n", out, update, score);
   };
 
@@ -255,6 +280,7 @@ int run(int argc, char** argv) {
           "s)\n",
           round, round == 0 ? "behaviour cloning" : "DAgger", st.samples, agreement,
           100 * st.fit_accuracy, wall());
+      checkpoint(fmt::format("imitation-{}", round));
     }
     // The warm-started policy is a candidate too: PPO's checkpoints replace it only by doing
     // better on the evaluation worlds.
@@ -290,6 +316,7 @@ int run(int argc, char** argv) {
             << std::flush;
       }
       save(r.mean_return, update);
+      checkpoint(fmt::format("update-{:05d}", update));
     }
   }
   fmt::print("done: {} steps in {:.0f} s ({:.0f} steps/s)\n", done_steps, wall(),
