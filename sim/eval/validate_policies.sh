@@ -84,7 +84,8 @@ done
 {
   echo "# Policy validation: the closed loop on random seeds $seed-$((seed + trials - 1))"
   echo
-  echo "Command: \`sim/eval/validate_policies.sh $out $*\`${DURATION_S:+ (DURATION_S=$DURATION_S)}, $(date -u +%Y-%m-%d)."
+  echo "Command: \`SEED=$seed TRIALS=$trials${DURATION_S:+ DURATION_S=$DURATION_S}" \
+    "sim/eval/validate_policies.sh $out $*\`, $(date -u +%Y-%m-%d)."
   echo
   echo "| selector | successes | e_x (m) | e_y (m) | e_θ (rad) | e_x + e_y | failures (seed: what) |"
   echo "|---|---|---|---|---|---|---|"

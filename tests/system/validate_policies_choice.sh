@@ -39,6 +39,7 @@ grep -q '^| objective | 1 / 1 | 0.100 | 0.100 | 0.100 | 0.200 | - |$' "$md"
 grep -q '^| fails | 1 / 2 | 0.150 | 0.150 | 0.200 | 0.300 | 102: collision with the person |$' "$md"
 grep -q '^| loose | 2 / 2 | 0.300 | 0.300 | 0.100 | 0.600 | - |$' "$md"
 grep -q '^Chosen: \*\*tight\*\*' "$md"
+grep -q "^Command: \`SEED=101 TRIALS=2 sim/eval/validate_policies.sh $work/v $work/c1/fails.bin " "$md"
 grep -q 'validate_policies: chose tight' "$work/out.log"
 cmp "$work/v/best.bin" "$work/c1/tight.bin"
 # The most successes wins over smaller errors.
