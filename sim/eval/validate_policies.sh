@@ -39,6 +39,10 @@ for p in "$@"; do  # all checked before the first (long) run
     exit 2
   fi
   name=$(basename "$p" .bin)
+  if [[ $name == *[[:space:]\|\&]* ]]; then  # names a table cell and a sed replacement
+    echo "validate_policies: '$p': a candidate's name may not hold spaces, '|' or '&'" >&2
+    exit 2
+  fi
   if [[ " ${names[*]} " == *" $name "* || $name == objective ]]; then
     echo "validate_policies: two candidates named '$name' (their results would share a directory)" >&2
     exit 2

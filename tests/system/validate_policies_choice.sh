@@ -54,5 +54,10 @@ if env EVAL="$work/eval" bash "$script" "$work/v4" "$work/c1/tight.bin" "$work/c
   echo "validate_policies accepted two candidates named alike"; exit 1
 fi
 grep -q "two candidates named 'tight'" "$work/e2.log"
-test ! -e "$work/v3" && test ! -e "$work/v4"
+cp "$work/c1/tight.bin" "$work/c1/a b.bin"
+if env EVAL="$work/eval" bash "$script" "$work/v5" "$work/c1/a b.bin" >"$work/e3.log" 2>&1; then
+  echo "validate_policies accepted a candidate named with a space"; exit 1
+fi
+grep -q "may not hold spaces" "$work/e3.log"
+test ! -e "$work/v3" && test ! -e "$work/v4" && test ! -e "$work/v5"
 echo "validate_policies: chooses by successes, then e_x + e_y; refuses bad candidates: ok"
