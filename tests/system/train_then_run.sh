@@ -33,6 +33,10 @@ if "$train" --out "$work/x.bin" --steps 0 --dagger-rounds 1 > "$work/x.log" 2>&1
   echo "companion-train accepted DAgger rounds without imitation rollouts"; exit 1
 fi
 grep -q -- "--dagger-rounds needs --imitate-rollouts" "$work/x.log"
+if "$train" --out "$work/y.bin" --steps 0 --checkpoints "$work/p.bin/ck" > "$work/y.log" 2>&1; then
+  echo "companion-train accepted a checkpoint directory it cannot make"; exit 1
+fi
+grep -q -- "--checkpoints $work/p.bin/ck: cannot make the directory" "$work/y.log"
 sed "s|^  file: \"\"|  file: \"$work/p.bin\"|" "$config" > "$work/policy.yaml"
 grep -q "file: \"$work/p.bin\"" "$work/policy.yaml"
 "$eval" --case open --method policy --duration-s 6 --jobs 1 -c "$work/policy.yaml" --out "$work/eval" > "$work/eval.log"
