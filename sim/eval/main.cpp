@@ -146,7 +146,8 @@ int run(int argc, char** argv) {
                  "size-AxB clutter-C")
       ->delimiter(',');
   app.add_option("--method", method_names,
-                 "methods: objective fixed_behind fixed_side pid policy (policy needs policy.file)")
+                 "methods: objective fixed_behind fixed_side pid policy (policy needs a policy "
+                 "file: policy.file or --policy-file)")
       ->delimiter(',');
   app.add_option("--trials", trials, "trials of the random and dead_end cases (paper: 50)")
       ->check(CLI::Range(1, 100000));
@@ -155,6 +156,9 @@ int run(int argc, char** argv) {
       ->check(CLI::Range(1U, 256U));
   app.add_option("--out", out_dir, "output directory (trials.csv, summary.md)");
   app.add_option("-c,--config", config_path, "daemon configuration (default: built-in defaults)");
+  std::string policy_file;
+  app.add_option("--policy-file", policy_file,
+                 "the learned selector's file for every trial (sets policy.file over --config's)");
   app.add_option("--pedestrians", pedestrians,
                  "recorded pedestrians (frame id x y) to follow through");
   app.add_option("--frame-period", frame_period, "seconds between consecutive frame values")
@@ -180,13 +184,14 @@ int run(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   CLI11_PARSE(app, argc, argv);
 
-  const auto loaded = config_path.empty() ? firmware::load_default_config()
-                                          : firmware::load_config_file(config_path);
+  auto loaded = config_path.empty() ? firmware::load_default_config()
+                                    : firmware::load_config_file(config_path);
   if (!loaded.ok()) {
     for (const auto& e : loaded.errors)
       std::cerr << "config error: " << e.to_string() << "\n";
     return 2;
   }
+  if (!policy_file.empty()) loaded.config->policy.file = policy_file;
   // Every trial's daemon loads a configured policy file (the selector decides whether it is
   // used): one that does not load stops here, before any trial, not in a worker.
   if (!loaded.config->policy.file.empty()) {
@@ -204,7 +209,8 @@ int run(int argc, char** argv) {
       return 2;
     }
     if (m->name == "policy" && loaded.config->policy.file.empty()) {
-      std::cerr << "method 'policy' needs a policy file (policy.file in --config)\n";
+      std::cerr << "method 'policy' needs a policy file (policy.file in --config, or "
+                   "--policy-file)\n";
       return 2;
     }
     methods.push_back(*m);

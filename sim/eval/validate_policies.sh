@@ -9,10 +9,10 @@
 #
 # Chosen: the most successes; among equals, the smallest e_x + e_y (the mean of the trials'
 # RMSEs), then the first named. Environment: EVAL (companion-eval, default
-# build/release/sim/companion-eval), SEED
-# (the first validation seed, default 101), TRIALS (default 80: seeds 101-180), CONFIG (the
-# daemon configuration the policy file is set in, default config/companiond.yaml), DURATION_S,
-# JOBS (as companion-eval's options).
+# build/release/sim/companion-eval), SEED (the first validation seed, default 101), TRIALS
+# (default 80: seeds 101-180), CONFIG (the daemon configuration of every trial, default
+# config/companiond.yaml; the candidate goes in by --policy-file), DURATION_S, JOBS (as
+# companion-eval's options).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 if [[ $# -lt 2 ]]; then
@@ -39,8 +39,8 @@ for p in "$@"; do  # all checked before the first (long) run
     exit 2
   fi
   name=$(basename "$p" .bin)
-  if [[ $name == *[[:space:]\|\&]* ]]; then  # names a table cell and a sed replacement
-    echo "validate_policies: '$p': a candidate's name may not hold spaces, '|' or '&'" >&2
+  if [[ $name == *[[:space:]\|]* ]]; then  # it names a table cell the choice reads back
+    echo "validate_policies: '$p': a candidate's name may not hold spaces or '|'" >&2
     exit 2
   fi
   if [[ " ${names[*]} " == *" $name "* || $name == objective ]]; then
@@ -67,13 +67,8 @@ row() {
 rows=("$(row objective "$out/objective/trials.csv")")
 for p in "$@"; do
   name=$(basename "$p" .bin)
-  abs=$(realpath "$p")
-  sed "s|^  file: \"\"|  file: \"$abs\"|" "$config" >"$out/$name.yaml"
-  if ! grep -q "^  file: \"$abs\"" "$out/$name.yaml"; then
-    echo "validate_policies: $config has no empty policy.file line to set" >&2
-    exit 2
-  fi
-  "$eval_bin" "${extra[@]}" -c "$out/$name.yaml" --method policy --out "$out/$name" >"$out/$name.log"
+  "$eval_bin" "${extra[@]}" -c "$config" --policy-file "$p" --method policy --out "$out/$name" \
+    >"$out/$name.log"
   rows+=("$(row "$name" "$out/$name/trials.csv")")
   echo "${rows[-1]}"
 done

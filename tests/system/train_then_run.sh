@@ -28,7 +28,12 @@ grep -q '^| objective | 1 / 1 |' "$work/val/VALIDATION.md"
 grep -q '^| imitation-1 | 1 / 1 |' "$work/val/VALIDATION.md"
 grep -q '^| update-00006 | 1 / 1 |' "$work/val/VALIDATION.md"
 test -s "$work/val/best.bin"
-grep -q "^  file: \"$(realpath "$work/ck/update-00006.bin")\"" "$work/val/update-00006.yaml"
+# --policy-file, the way validate_policies.sh hands each candidate in, refuses a truncated file.
+head -c 100 "$work/ck/update-00006.bin" > "$work/cut.bin"
+if "$eval" --case open --method policy --duration-s 1 --policy-file "$work/cut.bin" --out "$work/e3" > "$work/e3.log" 2>&1; then
+  echo "companion-eval accepted a truncated --policy-file"; exit 1
+fi
+grep -q "policy.file $work/cut.bin" "$work/e3.log"
 if "$train" --out "$work/x.bin" --steps 0 --dagger-rounds 1 > "$work/x.log" 2>&1; then
   echo "companion-train accepted DAgger rounds without imitation rollouts"; exit 1
 fi

@@ -12,7 +12,7 @@ cat >"$work/eval" <<'STANDIN'
 #!/usr/bin/env bash
 while [[ $# -gt 0 ]]; do
   case $1 in
-    -c) cfg=$2; shift 2 ;;
+    --policy-file) policy=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
     --method) method=$2; shift 2 ;;
     *) shift ;;
@@ -23,7 +23,7 @@ echo "case,method,seed,success,failure,rmse_ex_m,rmse_ey_m,rmse_etheta_rad" >"$o
 if [[ $method == objective ]]; then
   echo "random,objective,101,1,,0.1,0.1,0.1" >>"$out/trials.csv"
 else
-  cat "$(sed -n 's/^  file: "\(.*\)"$/\1/p' "$cfg")" >>"$out/trials.csv"
+  cat "$policy" >>"$out/trials.csv"
 fi
 STANDIN
 chmod +x "$work/eval"
@@ -58,6 +58,6 @@ cp "$work/c1/tight.bin" "$work/c1/a b.bin"
 if env EVAL="$work/eval" bash "$script" "$work/v5" "$work/c1/a b.bin" >"$work/e3.log" 2>&1; then
   echo "validate_policies accepted a candidate named with a space"; exit 1
 fi
-grep -q "may not hold spaces" "$work/e3.log"
+grep -q "may not hold spaces or '|'" "$work/e3.log"
 test ! -e "$work/v3" && test ! -e "$work/v4" && test ! -e "$work/v5"
 echo "validate_policies: chooses by successes, then e_x + e_y; refuses bad candidates: ok"
