@@ -95,7 +95,8 @@ const float* Mppi::noise_row(size_t block, size_t k, size_t d) const {
 
 // The structured samples' controls, written as the noise that makes them (n = (u - mean) /
 // sigma): lane 0 the mean, lane 1 a full brake, lanes 2 and 3 the steering law at full and half
-// speed, lanes 4-7 random (the pool's, as any other block).
+// speed, lane 4 the path round an obstacle when one was planned (MppiConfig::path_guide), the
+// rest random (the pool's, as any other block).
 void Mppi::prepare_guide_block(const MppiInputs& in) {
   constexpr size_t kL = kLanes;
   const size_t horizon = mean_.size();
@@ -116,31 +117,73 @@ void Mppi::prepare_guide_block(const MppiInputs& in) {
   // where q^d is at the same step (position and heading), at most `speed` of the box (scaled as a
   // vector, so the direction holds); every step within the base's accelerations, as the rollouts
   // will clamp it. (Pulling toward q^d one step later ran the law a step ahead of a walking
-  // person and its half-speed copy behind; the two tied ~5 cm behind and took turns.)
+  // person and its half-speed copy behind; the two tied ~5 cm behind and took turns.) With a
+  // carrot, the translation heads for it at the box's speed instead (the path sample).
+  auto law = [&](size_t k, const Pose2& p, const Twist& prev, double speed, const Point2* carrot) {
+    const TwistLimits box{lim.vx * speed, lim.vy * speed, lim.wz};
+    const GoalFrame& g0 = goal_frames_[std::min(k, goal_frames_.size() - 1)];
+    const GoalFrame& g1 = goal_frames_[std::min(k + 1, goal_frames_.size() - 1)];
+    double wx = (g1.x - g0.x) / dt + 2.0 * (g0.x - p.x_m);
+    double wy = (g1.y - g0.y) / dt + 2.0 * (g0.y - p.y_m);
+    if (carrot != nullptr) {  // as fast as the box allows, straight at the carrot
+      const double d = std::max(std::hypot(carrot->x_m - p.x_m, carrot->y_m - p.y_m), 1e-9);
+      wx = 10.0 * (carrot->x_m - p.x_m) / d;
+      wy = 10.0 * (carrot->y_m - p.y_m) / d;
+    }
+    const double c = std::cos(p.theta_rad);
+    const double s = std::sin(p.theta_rad);
+    double bx = c * wx + s * wy;
+    double by = -s * wx + c * wy;
+    const double scale = std::min(
+        {1.0, box.vx / std::max(std::abs(bx), 1e-9), box.vy / std::max(std::abs(by), 1e-9)});
+    bx *= scale;
+    by *= scale;
+    const double bw = std::clamp(
+        wrap_angle(g1.theta - g0.theta) / dt + 2.0 * wrap_angle(g0.theta - p.theta_rad), -box.wz,
+        box.wz);
+    return Twist{toward(prev.vx, bx, dv), toward(prev.vy, by, dv), toward(prev.wz, bw, dw)};
+  };
+  auto advance = [dt](const Pose2& p, const Twist& u) {
+    const double c = std::cos(p.theta_rad);
+    const double s = std::sin(p.theta_rad);
+    return Pose2{p.x_m + (u.vx * c - u.vy * s) * dt, p.y_m + (u.vx * s + u.vy * c) * dt,
+                 p.theta_rad + u.wz * dt};
+  };
   auto steer = [&](size_t lane, double speed) {
     Pose2 p = in.robot;
     Twist prev = in.current;
-    const TwistLimits box{lim.vx * speed, lim.vy * speed, lim.wz};
     for (size_t k = 0; k < horizon; ++k) {
-      const GoalFrame& g0 = goal_frames_[std::min(k, goal_frames_.size() - 1)];
-      const GoalFrame& g1 = goal_frames_[std::min(k + 1, goal_frames_.size() - 1)];
-      const double wx = (g1.x - g0.x) / dt + 2.0 * (g0.x - p.x_m);
-      const double wy = (g1.y - g0.y) / dt + 2.0 * (g0.y - p.y_m);
-      const double c = std::cos(p.theta_rad);
-      const double s = std::sin(p.theta_rad);
-      double bx = c * wx + s * wy;
-      double by = -s * wx + c * wy;
-      const double scale = std::min(
-          {1.0, box.vx / std::max(std::abs(bx), 1e-9), box.vy / std::max(std::abs(by), 1e-9)});
-      bx *= scale;
-      by *= scale;
-      const double bw = std::clamp(
-          wrap_angle(g1.theta - g0.theta) / dt + 2.0 * wrap_angle(g0.theta - p.theta_rad), -box.wz,
-          box.wz);
-      const Twist u{toward(prev.vx, bx, dv), toward(prev.vy, by, dv), toward(prev.wz, bw, dw)};
+      const Twist u = law(k, p, prev, speed, nullptr);
       put(lane, k, u);
-      p = Pose2{p.x_m + (u.vx * c - u.vy * s) * dt, p.y_m + (u.vx * s + u.vy * c) * dt,
-                p.theta_rad + u.wz * dt};
+      p = advance(p, u);
+      prev = u;
+    }
+  };
+  // The path sample: toward the path point path_lookahead_m beyond the one nearest the robot
+  // (found by walking forward along the path, so it never turns back), at full speed; once that
+  // point is the path's end (q^d now), the steering law.
+  auto follow = [&](size_t lane) {
+    Pose2 p = in.robot;
+    Twist prev = in.current;
+    const size_t last = path_.size() - 1;
+    size_t near = 0;
+    auto d2 = [&](size_t i) {
+      return std::pow(path_[i].x_m - p.x_m, 2) + std::pow(path_[i].y_m - p.y_m, 2);
+    };
+    bool on_path = true;
+    for (size_t k = 0; k < horizon; ++k) {
+      size_t carrot = near;
+      if (on_path) {
+        while (near < last && d2(near + 1) <= d2(near))
+          ++near;
+        carrot = near;
+        while (carrot < last && std::sqrt(d2(carrot)) < cfg_.path_lookahead_m)
+          ++carrot;
+        on_path = carrot < last;
+      }
+      const Twist u = law(k, p, prev, 1.0, on_path ? &path_[carrot] : nullptr);
+      put(lane, k, u);
+      p = advance(p, u);
       prev = u;
     }
   };
@@ -158,6 +201,7 @@ void Mppi::prepare_guide_block(const MppiInputs& in) {
   }
   steer(2, 1.0);
   steer(3, 0.5);
+  if (structured_lanes_ > 4) follow(4);
 }
 
 void Mppi::rollout_block(size_t block, const MppiInputs& in) {
@@ -253,7 +297,7 @@ void Mppi::rollout_block(size_t block, const MppiInputs& in) {
   // where it is worse.
   alignas(32) float control_weight[kL];
   for (size_t j = 0; j < kL; ++j)
-    control_weight[j] = block == guide_block_ && j < 4 ? 0.0f : 1.0f;
+    control_weight[j] = block == guide_block_ && j < structured_lanes_ ? 0.0f : 1.0f;
   for (size_t k = 0; k < horizon; ++k) {
     const auto mvx = static_cast<float>(mean_[k].vx);
     const auto mvy = static_cast<float>(mean_[k].vy);
@@ -351,6 +395,20 @@ MppiOutput Mppi::step(const MppiInputs& in) {
     // A block's noise is contiguous per (step, dimension): aligned to whole vectors.
     o = static_cast<uint32_t>(next_random(rng_state_) % kPoolSize) & ~uint32_t{kLanes - 1};
   }
+  structured_lanes_ = 4;
+  path_.clear();
+  if (guide_block_ != SIZE_MAX && cfg_.path_guide && in.costmap != nullptr) {
+    // Only round an obstacle's core on the straight line to q^d now: elsewhere the steering law
+    // is that path.
+    const GoalFrame& g = goal_frames_.front();
+    const Point2 from{in.robot.x_m, in.robot.y_m};
+    const Point2 to{g.x, g.y};
+    if (segment_crosses(*in.costmap, from, to, cfg_.path.blocked_cost) &&
+        planner_.plan(*in.costmap, from, to, cfg_.path, path_) == CostmapPathResult::kFound) {
+      structured_lanes_ = 5;
+      out.path_planned = true;
+    }
+  }
   if (guide_block_ != SIZE_MAX) prepare_guide_block(in);
   const auto blocks = static_cast<int64_t>(offset_.size());
 #pragma omp parallel for num_threads(cfg_.threads) schedule(static)
@@ -360,7 +418,9 @@ MppiOutput Mppi::step(const MppiInputs& in) {
   // they lie far from the mean on purpose, and any weight they had would pull it toward them
   // step after step (the brake toward a standstill) whether or not they were better. One of them
   // replaces the plan instead, when it beats every random sample.
-  auto structured = [&](size_t m) { return m / kLanes == guide_block_ && m % kLanes < 4; };
+  auto structured = [&](size_t m) {
+    return m / kLanes == guide_block_ && m % kLanes < structured_lanes_;
+  };
   double min_cost = std::numeric_limits<double>::infinity();
   size_t best = 0;
   double guide_cost = std::numeric_limits<double>::infinity();
@@ -382,6 +442,7 @@ MppiOutput Mppi::step(const MppiInputs& in) {
   }
   const bool take_guide = guide_cost < min_cost;
   out.guided = take_guide;
+  out.path_guided = take_guide && guide % kLanes == 4 && structured_lanes_ > 4;
   if (take_guide) best = guide;
   out.best.tracking = static_cast<double>(tracking_cost_[best]);
   out.best.collision = static_cast<double>(collision_cost_[best]);

@@ -430,3 +430,65 @@ TEST(PidFollower, RespectsTheAccelerationLimit) {
   const core::Twist u = pid.step({5.0, 0.0}, core::Nanos(std::chrono::milliseconds(10)));
   EXPECT_LE(u.vx, cfg.linear_accel_mps2 * 0.01 + 1e-9) << "from standstill, one 10 ms step";
 }
+
+// The path sample (mppi.path_guide): a wall between robot and goal, its near end 0.4 m below the
+// line and its far end 3 m above, the robot already moving up along it (its plan warm-started
+// that way). Random samples about that plan find the way round the top and keep it; the path
+// round the short end becomes the plan once it beats them.
+TEST(Mppi, ThePathSampleTakesTheShortWayRoundAWall) {
+  core::VoxelGridConfig gc;
+  gc.size_xy_m = 10.0;
+  core::VoxelGrid g(gc);
+  g.recentre(1.5, 0);
+  std::vector<core::Ray> rays;
+  for (double y = -0.4; y <= 3.0; y += 0.02)
+    rays.push_back({{1.5, -3.0, 3.0}, {1.5, y, 0.5}});
+  g.insert(rays, Pose2{30, 30, 0}, std::nullopt, 1s);
+  core::Costmap map;
+  map.build(g, core::CostmapConfig{}, 1s);
+  struct Result {
+    double highest_y = -9, time_s = 99, highest_cost = 0;
+    bool path_guided = false;
+  };
+  auto run = [&](bool path_guide) {
+    auto cfg = test_config();
+    cfg.guide_samples = true;
+    cfg.path_guide = path_guide;
+    cfg.horizon_steps = 100;
+    cfg.samples = 2000;
+    cfg.min_effective_samples = 50;
+    cfg.contact_cost = 1e5;
+    cfg.contact_threshold = 71.0;
+    cfg.limits = core::TwistLimits{1.8, 1.0, 2.0};
+    Loop loop(cfg);
+    loop.robot = Pose2{0.0, 0.5, 0.0};
+    loop.last = Twist{0.0, 0.8, 0.0};
+    for (int i = 0; i < 50; ++i)  // 0.5 s up toward a goal above the wall's far end
+      loop.tick(Pose2{0.0, 4.0, 0.0}, {}, &map);
+    loop.robot = Pose2{0.0, 0.5, 0.0};
+    Result r;
+    const Pose2 goal{3.0, 0.0, 0.0};
+    for (int i = 0; i < 1500; ++i) {
+      const auto out = loop.tick(goal, {}, &map);
+      EXPECT_TRUE(out.ok);
+      r.path_guided = r.path_guided || out.path_guided;
+      r.highest_y = std::max(r.highest_y, loop.robot.y_m);
+      r.highest_cost = std::max(r.highest_cost, map.cost(loop.robot.x_m, loop.robot.y_m));
+      if (std::hypot(loop.robot.x_m - goal.x_m, loop.robot.y_m - goal.y_m) < 0.3) {
+        r.time_s = 0.01 * i;
+        break;
+      }
+    }
+    return r;
+  };
+  const Result random_only = run(false);
+  const Result with_path = run(true);
+  std::printf("highest y / time to the goal: without the path %.2f m / %.2f s, with %.2f m / %.2f s\n",
+              random_only.highest_y, random_only.time_s, with_path.highest_y, with_path.time_s);
+  EXPECT_FALSE(random_only.path_guided);
+  EXPECT_GT(random_only.highest_y, 3.0) << "round the long end";
+  EXPECT_TRUE(with_path.path_guided);
+  EXPECT_LT(with_path.highest_y, 1.0) << "round the short end";
+  EXPECT_LT(with_path.time_s, random_only.time_s - 1.5);
+  EXPECT_LT(with_path.highest_cost, 71.0) << "the footprint never touches the wall";
+}

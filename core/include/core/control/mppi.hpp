@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "core/control/closing_speed.hpp"
+#include "core/control/costmap_path.hpp"
 #include "core/control/dcbf_repair.hpp"
 #include "core/geometry/pose2.hpp"
 #include "core/perception/costmap.hpp"
@@ -72,6 +73,15 @@ struct MppiConfig {
   // are not averaged in (any weight would pull the plan toward them, better or not): the best
   // of them becomes the plan when it costs less than every random sample.
   bool guide_samples = false;
+  // A ninth structured sample (with guide_samples; not in the paper): when the lethal core of an
+  // obstacle lies on the straight line from the robot to q^d, the costmap's shortest path round
+  // it (costmap_path.hpp) followed at full speed, then the steering law. Random samples explore
+  // a few tenths of a metre about the last plan, so round a cluster of obstacles the plan keeps
+  // the side it first found, the long one too. Scored like the others; becomes the plan only
+  // when it beats every random sample.
+  bool path_guide = false;
+  CostmapPathConfig path;
+  double path_lookahead_m = 0.6;  // the sample heads for the path point this far on
   int threads = 2;
   uint64_t seed = 1;
 };
@@ -106,6 +116,8 @@ struct MppiOutput {
   bool repair_feasible = true;
   bool closing_limited = false;  // slowed toward the person (ClosingSpeedConfig)
   bool guided = false;           // a structured sample beat every random one and became the plan
+  bool path_planned = false;     // an obstacle lay on the line to q^d and a path round it was found
+  bool path_guided = false;      // ... and its sample became the plan
   double min_cost = 0;           // best sample's cost
   MppiCostTerms best;            // ... by term
   double effective_samples = 0;  // 1 / sum(w^2): how many samples carried the update
@@ -141,6 +153,11 @@ class Mppi {
   // laid out as a pool block: (k * 3 + d) * kLanes + lane.
   size_t guide_block_ = SIZE_MAX;
   std::vector<float> guide_noise_;
+  // Lanes 0 .. structured_lanes_ - 1 of the guide block are structured (not averaged in): 4, or
+  // 5 with the path sample (lane 4) when a path was planned this step.
+  size_t structured_lanes_ = 4;
+  CostmapPathPlanner planner_;
+  std::vector<Point2> path_;  // robot -> q^d round the obstacles; empty: no path sample
   std::vector<double> cost_;                                          // per sample
   std::vector<float> tracking_cost_, collision_cost_, barrier_cost_;  // per sample, by term
   std::vector<double> weight_;                                        // per sample

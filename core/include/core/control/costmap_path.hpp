@@ -1,0 +1,77 @@
+#pragma once
+// The shortest way from the robot to q^d round the obstacles of the costmap: A* on a coarsened
+// copy of it (each planning cell the worst of the costmap cells it covers), 8-connected without
+// cutting corners. MPPI follows it with one structured sample (mppi.path_guide) when an
+// obstacle's lethal core lies on the straight line to q^d: its random samples explore a few
+// tenths of a metre about the last plan and the steering law drives straight at q^d, so round a
+// cluster of obstacles the plan keeps whichever side it first found, the long one too.
+// Not a navigation stack: a path per control step, bounded work (max_expansions), no allocation
+// once the costmap's size is known. (Nav2's NavFn and Smac planners are ROS-bound; no Debian
+// library plans on a grid in place.)
+#include <cstdint>
+#include <vector>
+
+#include "core/geometry/pose2.hpp"
+#include "core/perception/costmap.hpp"
+
+namespace core {
+
+struct CostmapPathConfig {
+  double cell_m = 0.1;  // planning cell; rounded to a whole number of costmap cells (>= 1)
+  // A move of length l costs l (1 + cost_weight c / 100) for a cell of cost c below
+  // unsafe_cost, l (1 + cost_weight + unsafe_penalty) at or above it; cells at or above
+  // blocked_cost are not entered, except on the way out of them (the robot may stand in an
+  // obstacle's core: the map moved, or it was pushed), at blocked_penalty more a metre.
+  double cost_weight = 2.0;
+  double unsafe_cost = 30.0;  // R
+  double unsafe_penalty = 10.0;
+  double blocked_cost = kCostLethal;
+  double blocked_penalty = 100.0;
+  int max_expansions = 6000;  // bounds the work: no path beyond it
+};
+
+enum class CostmapPathResult : uint8_t {
+  kFound,
+  kStartOffMap,
+  kGoalOffMap,
+  kGoalBlocked,
+  kNoWay,          // every reachable cell expanded, the goal not among them
+  kTooManyExpansions,
+};
+
+const char* to_string(CostmapPathResult r);
+
+class CostmapPathPlanner {
+ public:
+  // The path from `start` to `goal` (odom), start and goal included, the cell centres between
+  // them; empty unless kFound.
+  CostmapPathResult plan(const Costmap& map, Point2 start, Point2 goal,
+                         const CostmapPathConfig& config, std::vector<Point2>& path);
+  // Cells expanded by the last plan (its work).
+  [[nodiscard]] int expansions() const { return expansions_; }
+
+ private:
+  struct Open {
+    float f;
+    int32_t cell;
+  };
+  void coarsen(const Costmap& map, int factor);
+
+  int factor_ = 0;        // costmap cells per planning cell (a side)
+  int n_ = 0;             // planning cells per side
+  double cell_m_ = 0;     // their size
+  double ox_ = 0, oy_ = 0;
+  std::vector<uint8_t> cost_;           // n_ x n_, the worst costmap cell of each (per plan:
+                                        // ~20 us, cheaper than knowing when it is stale)
+  std::vector<float> g_;                // cost from the start
+  std::vector<int32_t> parent_;         // -1: none
+  std::vector<uint8_t> closed_;
+  std::vector<Open> open_;              // binary heap on f
+  int expansions_ = 0;
+};
+
+// True when a costmap cell at or above `cost` lies on the segment a -> b (sampled every half
+// costmap cell).
+bool segment_crosses(const Costmap& map, Point2 a, Point2 b, double cost);
+
+}  // namespace core
