@@ -147,6 +147,8 @@ core::MppiConfig mppi_config(const DaemonConfig& cfg) {
   c.cost_threshold = cfg.interactive_space.cost_threshold;
   c.contact_cost = m.contact_cost;
   c.guide_samples = m.guide_samples;
+  c.path_guide = m.path_guide;
+  c.path.unsafe_cost = cfg.interactive_space.cost_threshold;  // R, as the rollouts'
   // The footprint can touch an obstacle closer than its circumscribed radius.
   const double footprint_x_m =
       std::max(std::abs(cfg.costmap.footprint_x_min_m), std::abs(cfg.costmap.footprint_x_max_m));
@@ -616,6 +618,8 @@ bool Daemon::run_controller(Nanos now, core::BodyVelocity& requested) {
   if (out.repaired) ++control_state_.repairs;
   if (out.closing_limited) ++control_state_.closing_limits;
   if (out.guided) ++control_state_.guided_plans;
+  if (out.path_planned) ++control_state_.paths_planned;
+  if (out.path_guided) ++control_state_.path_guided_plans;
   control_state_.min_cost = out.min_cost;
   control_state_.best_cost = out.best;
   control_state_.effective_samples = out.effective_samples;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/control/closing_speed.hpp"
+#include "core/control/costmap_path.hpp"
 #include "core/control/mppi.hpp"
 #include "core/perception/costmap.hpp"
 #include "core/perception/voxel_grid.hpp"
@@ -190,6 +191,91 @@ void BM_CostmapCollisionTest(benchmark::State& state) {
       static_cast<double>(unsafe) / static_cast<double>(xs.size() * kLanes);
 }
 BENCHMARK(BM_CostmapCollisionTest)->ArgName("way")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+// A wall across the way (x = 1.5 m, y from -0.4 m to 3 m: its short end below the line from the
+// robot at the origin to q^d at (3, 0)), on the daemon's 12 m costmap; with `closed` 1, the wall
+// is a box round q^d too, so no way exists and the search stops at its bound.
+core::Costmap wall_scene(bool closed) {
+  core::VoxelGridConfig gc;
+  core::VoxelGrid g(gc);
+  g.recentre(0, 0);
+  std::vector<core::Ray> rays;
+  auto wall = [&](double x0, double y0, double x1, double y1) {
+    for (double f = 0; f <= 1.0; f += 0.005)
+      rays.push_back({{0, 0, 3.0}, {x0 + f * (x1 - x0), y0 + f * (y1 - y0), 0.5}});
+  };
+  wall(1.5, -0.4, 1.5, 3.0);
+  if (closed) {
+    wall(1.5, -1.5, 1.5, -0.4);
+    wall(1.5, -1.5, 4.5, -1.5);
+    wall(4.5, -1.5, 4.5, 3.0);
+    wall(4.5, 3.0, 1.5, 3.0);
+  }
+  g.insert(rays, core::Pose2{30, 30, 0}, std::nullopt, 1s);
+  core::Costmap m;
+  m.build(g, core::CostmapConfig{}, 1s);
+  return m;
+}
+
+// One costmap path (mppi.path_guide's, per control step while an obstacle's core is on the line
+// to q^d): coarsening the 240 x 240 map to 0.1 m cells, then A*. `closed` 0: round the wall's
+// short end; 1: no way, the search ends at max_expansions (the bound on the step's work).
+void BM_CostmapPath(benchmark::State& state) {
+  const bool closed = state.range(0) != 0;
+  const core::Costmap map = wall_scene(closed);
+  core::CostmapPathPlanner planner;
+  std::vector<core::Point2> path;
+  const core::CostmapPathConfig config;
+  core::CostmapPathResult r{};
+  for (auto _ : state) {
+    r = planner.plan(map, {0.0, 0.0}, {3.0, 0.0}, config, path);
+    benchmark::DoNotOptimize(path.data());
+  }
+  state.counters["found"] = r == core::CostmapPathResult::kFound ? 1 : 0;
+  state.counters["expansions"] = planner.expansions();
+}
+BENCHMARK(BM_CostmapPath)->ArgName("closed")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+// A full controller step as shipped (guide samples, contact tier, effective-sample floor; 1
+// thread) with the wall on the line to q^d: `path` 0 without the path sample (the baseline in
+// the same run), 1 with it (the straight-line test, a path planned every step, a ninth
+// structured rollout).
+void BM_MppiStepPathGuide(benchmark::State& state) {
+  core::MppiConfig cfg = firmware::mppi_config(*firmware::load_default_config().config);
+  cfg.threads = 1;
+  cfg.path_guide = state.range(0) != 0;
+  core::Mppi mppi(cfg);
+  const core::Costmap map = wall_scene(false);
+  core::MppiInputs in;
+  in.goal = core::Pose2{3.0, 0.0, 0.0};
+  in.costmap = &map;
+  core::Nanos t{0};
+  for (int i = 0; i < 20; ++i) {  // warm up
+    in.now = t;
+    in.current = mppi.step(in).command;
+    t += 10ms;
+  }
+  bool planned = false;
+  for (auto _ : state) {
+    in.now = t;
+    const auto out = mppi.step(in);
+    benchmark::DoNotOptimize(out);
+    planned = out.path_planned;
+    in.current = out.command;
+    t += 10ms;
+  }
+  state.counters["path_planned"] = planned ? 1 : 0;
+}
+BENCHMARK(BM_MppiStepPathGuide)
+    ->ArgName("path")
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1)
+    ->Repetitions(100)
+    ->ComputeStatistics("p50", [](const std::vector<double>& v) { return quantile(v, 0.5); })
+    ->ComputeStatistics("p99", [](const std::vector<double>& v) { return quantile(v, 0.99); })
+    ->ReportAggregatesOnly(true);
 
 // The paper's policy step: W, P, G, the observation (layout 1, 716 floats) and the MLP
 // 716 -> 256 -> 128 -> 64 -> 64 (ReLU), masked argmax. Random weights: the cost is the same.

@@ -148,8 +148,7 @@ CostmapPathResult CostmapPathPlanner::plan(const Costmap& map, Point2 start, Poi
                                     cost_[at(ci, nj)] >= config.blocked_cost)))) {
         continue;  // not into a blocked cell, nor diagonally past one's corner
       }
-      const float g =
-          g_[c] + (d < 4 ? step_m : diagonal_m) * 0.5f * (here + metre_cost(cost_[m]));
+      const float g = g_[c] + (d < 4 ? step_m : diagonal_m) * 0.5f * (here + metre_cost(cost_[m]));
       if (g < g_[m]) {
         g_[m] = g;
         parent_[m] = static_cast<int32_t>(c);
@@ -162,8 +161,10 @@ CostmapPathResult CostmapPathPlanner::plan(const Costmap& map, Point2 start, Poi
   // Back from the goal: the cell centres strictly between the start's and the goal's cells.
   for (int32_t c = parent_[target]; c >= 0 && static_cast<size_t>(c) != s; c = parent_[c]) {
     const auto cu = static_cast<size_t>(c);
-    path.push_back({ox_ + (static_cast<double>(cu % n) + 0.5) * cell_m_,
-                    oy_ + (static_cast<double>(cu / n) + 0.5) * cell_m_});
+    const size_t column = cu % n;
+    const size_t row = cu / n;
+    path.push_back({ox_ + (static_cast<double>(column) + 0.5) * cell_m_,
+                    oy_ + (static_cast<double>(row) + 0.5) * cell_m_});
   }
   path.push_back(start);
   std::reverse(path.begin(), path.end());

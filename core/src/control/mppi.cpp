@@ -138,9 +138,9 @@ void Mppi::prepare_guide_block(const MppiInputs& in) {
         {1.0, box.vx / std::max(std::abs(bx), 1e-9), box.vy / std::max(std::abs(by), 1e-9)});
     bx *= scale;
     by *= scale;
-    const double bw = std::clamp(
-        wrap_angle(g1.theta - g0.theta) / dt + 2.0 * wrap_angle(g0.theta - p.theta_rad), -box.wz,
-        box.wz);
+    const double bw =
+        std::clamp(wrap_angle(g1.theta - g0.theta) / dt + 2.0 * wrap_angle(g0.theta - p.theta_rad),
+                   -box.wz, box.wz);
     return Twist{toward(prev.vx, bx, dv), toward(prev.vy, by, dv), toward(prev.wz, bw, dw)};
   };
   auto advance = [dt](const Pose2& p, const Twist& u) {

@@ -822,6 +822,19 @@ std::vector<FieldSpec> build() {
        0,
        0,
        {}},
+      {"mppi.path_guide",
+       "bool",
+       "A ninth structured sample, with mppi.guide_samples (not in the paper): when the lethal "
+       "core of an obstacle lies on the straight line from the robot to q^d, the costmap's "
+       "shortest path round it (A* on 0.1 m cells, the unsafe band dear) followed at full "
+       "speed, then the steering law. Random samples explore a few tenths of a metre about the "
+       "last plan, so round a cluster of obstacles the plan keeps the side it first found, the "
+       "long one too. Becomes the plan only when it beats every random sample. Counted in "
+       "control.paths_planned and control.path_guided_plans. false: eight structured samples.",
+       FIELD(mppi.path_guide),
+       0,
+       0,
+       {}},
       {"mppi.noise_vx_mps",
        "m/s",
        "Sigma: std-dev of the sampled forward-velocity noise (> 0: the control cost divides by "

@@ -483,8 +483,9 @@ TEST(Mppi, ThePathSampleTakesTheShortWayRoundAWall) {
   };
   const Result random_only = run(false);
   const Result with_path = run(true);
-  std::printf("highest y / time to the goal: without the path %.2f m / %.2f s, with %.2f m / %.2f s\n",
-              random_only.highest_y, random_only.time_s, with_path.highest_y, with_path.time_s);
+  std::printf(
+      "highest y / time to the goal: without the path %.2f m / %.2f s, with %.2f m / %.2f s\n",
+      random_only.highest_y, random_only.time_s, with_path.highest_y, with_path.time_s);
   EXPECT_FALSE(random_only.path_guided);
   EXPECT_GT(random_only.highest_y, 3.0) << "round the long end";
   EXPECT_TRUE(with_path.path_guided);

@@ -102,7 +102,8 @@ TEST(CostmapPath, PrefersFreeSpaceToTheUnsafeBand) {
   std::vector<Point2> path;
   ASSERT_EQ(planner.plan(map, {0.0, 0.0}, {3.0, 0.0}, {}, path), CostmapPathResult::kFound);
   bool through_gap = false;
-  for (const Point2& p : path) through_gap = through_gap || (std::abs(p.x_m - 1.5) < 0.1 && std::abs(p.y_m) < 0.5);
+  for (const Point2& p : path)
+    through_gap = through_gap || (std::abs(p.x_m - 1.5) < 0.1 && std::abs(p.y_m) < 0.5);
   EXPECT_FALSE(through_gap) << "round a post, not through the band between them";
   // Without the band's penalty the gap is the shortest way.
   core::CostmapPathConfig flat;
@@ -110,7 +111,8 @@ TEST(CostmapPath, PrefersFreeSpaceToTheUnsafeBand) {
   flat.unsafe_penalty = 0;
   ASSERT_EQ(planner.plan(map, {0.0, 0.0}, {3.0, 0.0}, flat, path), CostmapPathResult::kFound);
   through_gap = false;
-  for (const Point2& p : path) through_gap = through_gap || (std::abs(p.x_m - 1.5) < 0.1 && std::abs(p.y_m) < 0.5);
+  for (const Point2& p : path)
+    through_gap = through_gap || (std::abs(p.x_m - 1.5) < 0.1 && std::abs(p.y_m) < 0.5);
   EXPECT_TRUE(through_gap);
 }
 
@@ -133,8 +135,7 @@ TEST(CostmapPath, RefusesWhatItCannotPlan) {
   EXPECT_LE(planner.expansions(), 51);
   EXPECT_EQ(planner.plan(map, {0.0, 0.0}, {2.0, 0.0}, {}, path), CostmapPathResult::kGoalBlocked);
   EXPECT_EQ(planner.plan(map, {0.0, 0.0}, {30.0, 0.0}, {}, path), CostmapPathResult::kGoalOffMap);
-  EXPECT_EQ(planner.plan(map, {-30.0, 0.0}, {0.5, 0.0}, {}, path),
-            CostmapPathResult::kStartOffMap);
+  EXPECT_EQ(planner.plan(map, {-30.0, 0.0}, {0.5, 0.0}, {}, path), CostmapPathResult::kStartOffMap);
   EXPECT_EQ(planner.plan(map, {std::nan(""), 0.0}, {0.5, 0.0}, {}, path),
             CostmapPathResult::kStartOffMap);
   EXPECT_EQ(planner.plan(core::Costmap{}, {0.0, 0.0}, {0.5, 0.0}, {}, path),
@@ -155,6 +156,7 @@ TEST(CostmapPath, StartsFromABlockedCell) {
   // Behind the wall, the way is out on the near side and round its short end, not through it.
   ASSERT_EQ(planner.plan(map, start, {2.5, 1.0}, {}, path), CostmapPathResult::kFound);
   double least_y = 9;
-  for (const Point2& p : path) least_y = std::min(least_y, p.y_m);
+  for (const Point2& p : path)
+    least_y = std::min(least_y, p.y_m);
   EXPECT_LT(least_y, -0.4 - 0.35);
 }

@@ -158,7 +158,7 @@ class Mppi {
   size_t structured_lanes_ = 4;
   CostmapPathPlanner planner_;
   std::vector<Point2> path_;  // robot -> q^d round the obstacles; empty: no path sample
-  std::vector<double> cost_;                                          // per sample
+  std::vector<double> cost_;  // per sample
   std::vector<float> tracking_cost_, collision_cost_, barrier_cost_;  // per sample, by term
   std::vector<double> weight_;                                        // per sample
   std::vector<uint32_t> active_;  // samples that carry weight (capacity M: no allocation)
