@@ -461,6 +461,41 @@ TEST(ClosedLoop, TheClosingSpeedLimitKeepsACatchingUpRobotOffATurningPerson) {
   EXPECT_GT(on.metrics.min_person_distance_m, off.metrics.min_person_distance_m);
 }
 
+// mppi.path_guide through the daemon: the key reaches the controller and the status counts the
+// steps with a costmap path (control.paths_planned) and those where following it became the plan
+// (control.path_guided_plans); off, neither moves. Dead end, validation seed 114
+// (docs/EVALUATION.md): the robot leads the person into a dead end and must get behind them as
+// they walk back out; q^d's way runs past the robot where the footprint would touch the wall.
+// (Whether the sample wins is the controller's cost to decide: here it is planned ~80 times in
+// 31 s and is never the plan. Core: Mppi.ThePathSampleTakesTheShortWayRoundAWall.)
+TEST(ClosedLoop, PathGuideIsPlannedThroughTheDaemonAndCounted) {
+  auto run = [](bool path_guide, uint64_t& planned, uint64_t& guided) {
+    SimRunOptions o;
+    o.config = defaults();
+    o.scenario = *sim::make_scenario("dead_end", 114);
+    o.seed = 114;
+    o.duration_s = 31.0;
+    o.config.mppi.path_guide = path_guide;
+    o.script = [&](double, sim::SimWorld&, firmware::Daemon& d) {
+      if (const auto c = d.control_status().read()) {
+        planned = c->value.paths_planned;
+        guided = c->value.path_guided_plans;
+      }
+    };
+    return sim::run_simulation(o);
+  };
+  uint64_t planned_off = 0, guided_off = 0, planned_on = 0, guided_on = 0;
+  run(false, planned_off, guided_off);
+  run(true, planned_on, guided_on);
+  std::printf("control steps with a path: %llu, where it became the plan: %llu\n",
+              static_cast<unsigned long long>(planned_on),
+              static_cast<unsigned long long>(guided_on));
+  EXPECT_EQ(planned_off, 0U);
+  EXPECT_EQ(guided_off, 0U);
+  EXPECT_GT(planned_on, 20U);
+  EXPECT_LE(guided_on, planned_on);
+}
+
 TEST(ClosedLoop, GuideSamplesBrakeAndTurnWhereRandomSamplesSwingWide) {
   // Constrained world clutter-1, seed 6 (docs/EVALUATION.md): the robot follows 1.2 m behind the
   // person at ~1.7 m/s when they turn 85 degrees left at 12.3 s. With the M random samples alone

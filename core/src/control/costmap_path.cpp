@@ -82,7 +82,11 @@ CostmapPathResult CostmapPathPlanner::plan(const Costmap& map, Point2 start, Poi
   if (!index_of(goal, gi, gj)) return CostmapPathResult::kGoalOffMap;
   const auto n = static_cast<size_t>(n_);
   const auto at = [n](int i, int j) { return static_cast<size_t>(j) * n + static_cast<size_t>(i); };
-  if (cost_[at(gi, gj)] >= config.blocked_cost) return CostmapPathResult::kGoalBlocked;
+  // A goal where the footprint would touch (q^d beside an obstacle) is still reached; in the
+  // lethal core it is not.
+  if (cost_[at(gi, gj)] >= std::max(config.blocked_cost, static_cast<double>(kCostLethal))) {
+    return CostmapPathResult::kGoalBlocked;
+  }
 
   std::fill(g_.begin(), g_.end(), std::numeric_limits<float>::infinity());
   std::fill(closed_.begin(), closed_.end(), uint8_t{0});
@@ -143,9 +147,10 @@ CostmapPathResult CostmapPathPlanner::plan(const Costmap& map, Point2 start, Poi
       if (ni < 0 || nj < 0 || ni >= n_ || nj >= n_) continue;
       const size_t m = at(ni, nj);
       if (closed_[m] != 0) continue;
-      if (!escaping && (cost_[m] >= config.blocked_cost ||
-                        (d >= 4 && (cost_[at(ni, cj)] >= config.blocked_cost ||
-                                    cost_[at(ci, nj)] >= config.blocked_cost)))) {
+      if (!escaping && m != target &&
+          (cost_[m] >= config.blocked_cost ||
+           (d >= 4 && (cost_[at(ni, cj)] >= config.blocked_cost ||
+                       cost_[at(ci, nj)] >= config.blocked_cost)))) {
         continue;  // not into a blocked cell, nor diagonally past one's corner
       }
       const float g = g_[c] + (d < 4 ? step_m : diagonal_m) * 0.5f * (here + metre_cost(cost_[m]));

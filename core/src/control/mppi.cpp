@@ -49,6 +49,12 @@ Mppi::Mppi(const MppiConfig& config)
   person_frames_.reserve(static_cast<size_t>(config.horizon_steps) + 1);
   goal_frames_.reserve(static_cast<size_t>(config.horizon_steps) + 1);
   active_.reserve(weight_.size());
+  // The path sample's buffers (a path is at most the cells its search expanded, plus its ends):
+  // no allocation in the control loop.
+  const auto most_points = static_cast<size_t>(std::max(config.path.max_expansions, 0)) + 3;
+  path_.reserve(most_points);
+  path_arc_.reserve(most_points);
+  goal_arc_.reserve(static_cast<size_t>(config.horizon_steps) + 1);
   // Standard normals by Box-Muller from the seeded generator: same seed, same pool.
   for (size_t i = 0; i + 1 < pool_.size(); i += 2) {
     const double u1 = (static_cast<double>(next_random(rng_state_) >> 11) + 1.0) * 0x1.0p-53;
@@ -118,17 +124,17 @@ void Mppi::prepare_guide_block(const MppiInputs& in) {
   // vector, so the direction holds); every step within the base's accelerations, as the rollouts
   // will clamp it. (Pulling toward q^d one step later ran the law a step ahead of a walking
   // person and its half-speed copy behind; the two tied ~5 cm behind and took turns.) With a
-  // carrot, the translation heads for it at the box's speed instead (the path sample).
-  auto law = [&](size_t k, const Pose2& p, const Twist& prev, double speed, const Point2* carrot) {
+  // carrot (the path sample), the translation tracks the carrot's path instead of q^d's.
+  auto law = [&](size_t k, const Pose2& p, const Twist& prev, double speed, const Point2* carrot0,
+                 const Point2* carrot1) {
     const TwistLimits box{lim.vx * speed, lim.vy * speed, lim.wz};
     const GoalFrame& g0 = goal_frames_[std::min(k, goal_frames_.size() - 1)];
     const GoalFrame& g1 = goal_frames_[std::min(k + 1, goal_frames_.size() - 1)];
     double wx = (g1.x - g0.x) / dt + 2.0 * (g0.x - p.x_m);
     double wy = (g1.y - g0.y) / dt + 2.0 * (g0.y - p.y_m);
-    if (carrot != nullptr) {  // as fast as the box allows, straight at the carrot
-      const double d = std::max(std::hypot(carrot->x_m - p.x_m, carrot->y_m - p.y_m), 1e-9);
-      wx = 10.0 * (carrot->x_m - p.x_m) / d;
-      wy = 10.0 * (carrot->y_m - p.y_m) / d;
+    if (carrot0 != nullptr && carrot1 != nullptr) {
+      wx = (carrot1->x_m - carrot0->x_m) / dt + 2.0 * (carrot0->x_m - p.x_m);
+      wy = (carrot1->y_m - carrot0->y_m) / dt + 2.0 * (carrot0->y_m - p.y_m);
     }
     const double c = std::cos(p.theta_rad);
     const double s = std::sin(p.theta_rad);
@@ -153,38 +159,46 @@ void Mppi::prepare_guide_block(const MppiInputs& in) {
     Pose2 p = in.robot;
     Twist prev = in.current;
     for (size_t k = 0; k < horizon; ++k) {
-      const Twist u = law(k, p, prev, speed, nullptr);
+      const Twist u = law(k, p, prev, speed, nullptr, nullptr);
       put(lane, k, u);
       p = advance(p, u);
       prev = u;
     }
   };
-  // The path sample: toward the path point path_lookahead_m beyond the one nearest the robot
-  // (found by walking forward along the path, so it never turns back), at full speed; once that
-  // point is the path's end (q^d now), the steering law.
+  // The path sample: the steering law on a carrot that moves along the costmap path to q^d at
+  // the horizon's end (q^d's own way runs through what the footprint would touch, or round an
+  // obstacle the robot is on the wrong side of) at path_speed_mps, but never to where it would
+  // have less left to go than q^d has: it waits for a q^d that is still to come, and reaches a
+  // q^d that stands still.
   auto follow = [&](size_t lane) {
     Pose2 p = in.robot;
     Twist prev = in.current;
-    const size_t last = path_.size() - 1;
-    size_t near = 0;
-    auto d2 = [&](size_t i) {
-      return std::pow(path_[i].x_m - p.x_m, 2) + std::pow(path_[i].y_m - p.y_m, 2);
+    const double length = path_arc_.back();
+    const size_t last_goal = goal_frames_.size() - 1;
+    const double goal_length = goal_arc_.back();
+    size_t segment = 0;  // carrots only move forward along the path
+    auto point_at = [&](double arc) {
+      while (segment + 2 < path_arc_.size() && path_arc_[segment + 1] < arc)
+        ++segment;
+      const double span = path_arc_[segment + 1] - path_arc_[segment];
+      const double f = span > 0 ? std::clamp((arc - path_arc_[segment]) / span, 0.0, 1.0) : 1.0;
+      const Point2& a = path_[segment];
+      const Point2& b = path_[segment + 1];
+      return Point2{a.x_m + f * (b.x_m - a.x_m), a.y_m + f * (b.y_m - a.y_m)};
     };
-    bool on_path = true;
+    auto arc_at = [&](size_t k) {
+      const double left = goal_length - goal_arc_[std::min(k, last_goal)];
+      const double catching_up = cfg_.path_speed_mps * dt * static_cast<double>(k);
+      return std::clamp(std::min(length - left, catching_up), 0.0, length);
+    };
+    Point2 carrot0 = point_at(arc_at(0));
     for (size_t k = 0; k < horizon; ++k) {
-      size_t carrot = near;
-      if (on_path) {
-        while (near < last && d2(near + 1) <= d2(near))
-          ++near;
-        carrot = near;
-        while (carrot < last && std::sqrt(d2(carrot)) < cfg_.path_lookahead_m)
-          ++carrot;
-        on_path = carrot < last;
-      }
-      const Twist u = law(k, p, prev, 1.0, on_path ? &path_[carrot] : nullptr);
+      const Point2 carrot1 = point_at(arc_at(k + 1));
+      const Twist u = law(k, p, prev, 1.0, &carrot0, &carrot1);
       put(lane, k, u);
       p = advance(p, u);
       prev = u;
+      carrot0 = carrot1;
     }
   };
   Twist brake = in.current;
@@ -398,13 +412,46 @@ MppiOutput Mppi::step(const MppiInputs& in) {
   structured_lanes_ = 4;
   path_.clear();
   if (guide_block_ != SIZE_MAX && cfg_.path_guide && in.costmap != nullptr) {
-    // Only round an obstacle's core on the straight line to q^d now: elsewhere the steering law
-    // is that path.
-    const GoalFrame& g = goal_frames_.front();
+    // Cells where the footprint would touch (the contact tier's), or the lethal core without
+    // it, on the robot's straight line to q^d now or on q^d's own way over the horizon (every
+    // second): the steering law would run through them. The path goes round, to q^d at the end.
+    CostmapPathConfig path_config = cfg_.path;
+    if (cfg_.contact_cost > 0.0) {
+      path_config.blocked_cost = std::min(path_config.blocked_cost, cfg_.contact_threshold);
+    }
     const Point2 from{in.robot.x_m, in.robot.y_m};
-    const Point2 to{g.x, g.y};
-    if (segment_crosses(*in.costmap, from, to, cfg_.path.blocked_cost) &&
-        planner_.plan(*in.costmap, from, to, cfg_.path, path_) == CostmapPathResult::kFound) {
+    Point2 previous = from;
+    bool blocked = false;
+    const size_t last_goal = goal_frames_.size() - 1;
+    for (size_t k = 0; !blocked; k += 10) {
+      const GoalFrame& g = goal_frames_[std::min(k, last_goal)];
+      const Point2 next{g.x, g.y};
+      blocked = segment_crosses(*in.costmap, previous, next, path_config.blocked_cost);
+      previous = next;
+      if (k >= last_goal) break;
+    }
+    // The path keeps out of the unsafe band (cost >= R) where it can, so that the law following
+    // it with some error stays clear of the contact tier too; through the band only where
+    // nothing else leads there (a gap the band closes).
+    const GoalFrame& end = goal_frames_.back();
+    auto plan_below = [&](double cost) {
+      CostmapPathConfig c = path_config;
+      c.blocked_cost = cost;
+      return planner_.plan(*in.costmap, from, {end.x, end.y}, c, path_) ==
+             CostmapPathResult::kFound;
+    };
+    if (blocked && (plan_below(cfg_.cost_threshold) || plan_below(path_config.blocked_cost))) {
+      path_arc_.assign(1, 0.0);
+      for (size_t i = 1; i < path_.size(); ++i) {
+        path_arc_.push_back(path_arc_.back() + std::hypot(path_[i].x_m - path_[i - 1].x_m,
+                                                          path_[i].y_m - path_[i - 1].y_m));
+      }
+      goal_arc_.assign(1, 0.0);
+      for (size_t k = 1; k < goal_frames_.size(); ++k) {
+        goal_arc_.push_back(goal_arc_.back() +
+                            std::hypot(goal_frames_[k].x - goal_frames_[k - 1].x,
+                                       goal_frames_[k].y - goal_frames_[k - 1].y));
+      }
       structured_lanes_ = 5;
       out.path_planned = true;
     }

@@ -824,13 +824,16 @@ std::vector<FieldSpec> build() {
        {}},
       {"mppi.path_guide",
        "bool",
-       "A ninth structured sample, with mppi.guide_samples (not in the paper): when the lethal "
-       "core of an obstacle lies on the straight line from the robot to q^d, the costmap's "
-       "shortest path round it (A* on 0.1 m cells, the unsafe band dear) followed at full "
-       "speed, then the steering law. Random samples explore a few tenths of a metre about the "
-       "last plan, so round a cluster of obstacles the plan keeps the side it first found, the "
-       "long one too. Becomes the plan only when it beats every random sample. Counted in "
-       "control.paths_planned and control.path_guided_plans. false: eight structured samples.",
+       "A ninth structured sample, with mppi.guide_samples (not in the paper): when the robot's "
+       "straight line to q^d, or q^d's own way over the horizon, runs where the footprint would "
+       "touch an obstacle, the costmap's shortest path round it to q^d at the horizon's end (A* "
+       "on 0.1 m cells, outside the unsafe band where it can), followed by the steering law on "
+       "a carrot that runs along it at 1 m/s but never has less left to go than q^d has. Random "
+       "samples explore a few tenths of a metre about the last plan and the steering law goes "
+       "where q^d goes, so round obstacles the plan keeps the side it first found, and where the "
+       "person passes close by an obstacle the law runs into it. Becomes the plan only when it "
+       "beats every random sample. Counted in control.paths_planned and "
+       "control.path_guided_plans. false: eight structured samples.",
        FIELD(mppi.path_guide),
        0,
        0,

@@ -1,10 +1,11 @@
 #pragma once
 // The shortest way from the robot to q^d round the obstacles of the costmap: A* on a coarsened
 // copy of it (each planning cell the worst of the costmap cells it covers), 8-connected without
-// cutting corners. MPPI follows it with one structured sample (mppi.path_guide) when an
-// obstacle's lethal core lies on the straight line to q^d: its random samples explore a few
-// tenths of a metre about the last plan and the steering law drives straight at q^d, so round a
-// cluster of obstacles the plan keeps whichever side it first found, the long one too.
+// cutting corners. MPPI follows it with one structured sample (mppi.path_guide) when the robot's
+// straight line to q^d, or q^d's own way, runs where the footprint would touch an obstacle: its
+// random samples explore a few tenths of a metre about the last plan and the steering law goes
+// where q^d goes, so round a cluster of obstacles the plan keeps whichever side it first found,
+// the long one too, and past an obstacle the person brushes the law runs into it.
 // Not a navigation stack: a path per control step, bounded work (max_expansions), no allocation
 // once the costmap's size is known. (Nav2's NavFn and Smac planners are ROS-bound; no Debian
 // library plans on a grid in place.)
@@ -20,8 +21,9 @@ struct CostmapPathConfig {
   double cell_m = 0.1;  // planning cell; rounded to a whole number of costmap cells (>= 1)
   // A move of length l costs l (1 + cost_weight c / 100) for a cell of cost c below
   // unsafe_cost, l (1 + cost_weight + unsafe_penalty) at or above it; cells at or above
-  // blocked_cost are not entered, except on the way out of them (the robot may stand in an
-  // obstacle's core: the map moved, or it was pushed), at blocked_penalty more a metre.
+  // blocked_cost are not entered, except the goal's and on the way out of them (the robot may
+  // stand in an obstacle's core: the map moved, or it was pushed), at blocked_penalty more a
+  // metre.
   double cost_weight = 2.0;
   double unsafe_cost = 30.0;  // R
   double unsafe_penalty = 10.0;
@@ -36,8 +38,8 @@ enum class CostmapPathResult : uint8_t {
   kFound,
   kStartOffMap,
   kGoalOffMap,
-  kGoalBlocked,
-  kNoWay,  // every reachable cell expanded, the goal not among them
+  kGoalBlocked,  // in the lethal core (a goal merely at or above blocked_cost is reached)
+  kNoWay,        // every reachable cell expanded, the goal not among them
   kTooManyExpansions,
 };
 

@@ -73,15 +73,18 @@ struct MppiConfig {
   // are not averaged in (any weight would pull the plan toward them, better or not): the best
   // of them becomes the plan when it costs less than every random sample.
   bool guide_samples = false;
-  // A ninth structured sample (with guide_samples; not in the paper): when the lethal core of an
-  // obstacle lies on the straight line from the robot to q^d, the costmap's shortest path round
-  // it (costmap_path.hpp) followed at full speed, then the steering law. Random samples explore
-  // a few tenths of a metre about the last plan, so round a cluster of obstacles the plan keeps
-  // the side it first found, the long one too. Scored like the others; becomes the plan only
-  // when it beats every random sample.
+  // A ninth structured sample (with guide_samples; not in the paper): when the robot's straight
+  // line to q^d, or q^d's own way over the horizon, runs where the footprint would touch (the
+  // contact tier's cost; the lethal core without it), the costmap's shortest path round it to
+  // q^d at the horizon's end (costmap_path.hpp), followed by the steering law on a carrot that
+  // runs along it at path_speed_mps but never has less left to go than q^d has. Random samples
+  // explore a few tenths of a metre about the last plan, and the steering law goes where q^d
+  // goes, so round a cluster of obstacles the plan keeps the side it first found, the long one
+  // too, and where the person passes close by an obstacle the law runs into it. Scored like the
+  // others; becomes the plan only when it beats every random sample.
   bool path_guide = false;
   CostmapPathConfig path;
-  double path_lookahead_m = 0.6;  // the sample heads for the path point this far on
+  double path_speed_mps = 1.0;  // 1.5 cut the corner round a wall end into the contact tier
   int threads = 2;
   uint64_t seed = 1;
 };
@@ -157,8 +160,10 @@ class Mppi {
   // 5 with the path sample (lane 4) when a path was planned this step.
   size_t structured_lanes_ = 4;
   CostmapPathPlanner planner_;
-  std::vector<Point2> path_;  // robot -> q^d round the obstacles; empty: no path sample
-  std::vector<double> cost_;  // per sample
+  std::vector<Point2> path_;      // robot -> q^d round the obstacles; empty: no path sample
+  std::vector<double> path_arc_;  // arc length along path_ at each of its points
+  std::vector<double> goal_arc_;  // arc length along q^d's path at each goal frame
+  std::vector<double> cost_;      // per sample
   std::vector<float> tracking_cost_, collision_cost_, barrier_cost_;  // per sample, by term
   std::vector<double> weight_;                                        // per sample
   std::vector<uint32_t> active_;  // samples that carry weight (capacity M: no allocation)
