@@ -45,6 +45,17 @@ core::Costmap scene() {
   return m;
 }
 
+// A controller step timed one at a time (100 repetitions of one iteration), reported as p50 and
+// p99 in milliseconds.
+void one_step_percentiles(benchmark::internal::Benchmark* b) {
+  b->Unit(benchmark::kMillisecond)
+      ->Iterations(1)
+      ->Repetitions(100)
+      ->ComputeStatistics("p50", [](const std::vector<double>& v) { return quantile(v, 0.5); })
+      ->ComputeStatistics("p99", [](const std::vector<double>& v) { return quantile(v, 0.99); })
+      ->ReportAggregatesOnly(true);
+}
+
 // One controller per thread count, kept across repetitions: each repetition times one warm step
 // (as at 100 Hz on the robot), not the construction and the first touch of its buffers.
 struct Warm {
@@ -111,12 +122,7 @@ BENCHMARK(BM_MppiStep)
     ->Args({2, 0, 0})
     ->Args({2, 50, 0})
     ->Args({2, 50, 1})
-    ->Unit(benchmark::kMillisecond)
-    ->Iterations(1)
-    ->Repetitions(100)
-    ->ComputeStatistics("p50", [](const std::vector<double>& v) { return quantile(v, 0.5); })
-    ->ComputeStatistics("p99", [](const std::vector<double>& v) { return quantile(v, 0.99); })
-    ->ReportAggregatesOnly(true);
+    ->Apply(one_step_percentiles);
 
 void BM_InteractiveSpaceSelect(benchmark::State& state) {
   core::InteractiveSpace w(core::InteractiveSpaceConfig{});
@@ -266,16 +272,7 @@ void BM_MppiStepPathGuide(benchmark::State& state) {
   }
   state.counters["path_planned"] = planned ? 1 : 0;
 }
-BENCHMARK(BM_MppiStepPathGuide)
-    ->ArgName("path")
-    ->Arg(0)
-    ->Arg(1)
-    ->Unit(benchmark::kMillisecond)
-    ->Iterations(1)
-    ->Repetitions(100)
-    ->ComputeStatistics("p50", [](const std::vector<double>& v) { return quantile(v, 0.5); })
-    ->ComputeStatistics("p99", [](const std::vector<double>& v) { return quantile(v, 0.99); })
-    ->ReportAggregatesOnly(true);
+BENCHMARK(BM_MppiStepPathGuide)->ArgName("path")->Arg(0)->Arg(1)->Apply(one_step_percentiles);
 
 // The paper's policy step: W, P, G, the observation (layout 1, 716 floats) and the MLP
 // 716 -> 256 -> 128 -> 64 -> 64 (ReLU), masked argmax. Random weights: the cost is the same.

@@ -114,13 +114,14 @@ TEST(Mppi, NeverEntersTheEllipseOfAPersonWalkingTowardTheRobot) {
   }
 }
 
-core::Costmap wall_map() {
+// A wall along x = 1.5 m from y_min to y_max (marked by rays from high above).
+core::Costmap wall_map(double y_min_m = -0.6, double y_max_m = 0.6) {
   core::VoxelGridConfig gc;
   gc.size_xy_m = 10.0;
   core::VoxelGrid g(gc);
   g.recentre(1.5, 0);
   std::vector<core::Ray> rays;
-  for (double y = -0.6; y <= 0.6; y += 0.02)
+  for (double y = y_min_m; y <= y_max_m; y += 0.02)
     rays.push_back({{1.5, -3.0, 3.0}, {1.5, y, 0.5}});
   g.insert(rays, Pose2{30, 30, 0}, std::nullopt, 1s);
   core::Costmap m;
@@ -436,16 +437,7 @@ TEST(PidFollower, RespectsTheAccelerationLimit) {
 // that way). Random samples about that plan find the way round the top and keep it; the path
 // round the short end becomes the plan once it beats them.
 TEST(Mppi, ThePathSampleTakesTheShortWayRoundAWall) {
-  core::VoxelGridConfig gc;
-  gc.size_xy_m = 10.0;
-  core::VoxelGrid g(gc);
-  g.recentre(1.5, 0);
-  std::vector<core::Ray> rays;
-  for (double y = -0.4; y <= 3.0; y += 0.02)
-    rays.push_back({{1.5, -3.0, 3.0}, {1.5, y, 0.5}});
-  g.insert(rays, Pose2{30, 30, 0}, std::nullopt, 1s);
-  core::Costmap map;
-  map.build(g, core::CostmapConfig{}, 1s);
+  const core::Costmap map = wall_map(-0.4, 3.0);
   struct Result {
     double highest_y = -9, time_s = 99, highest_cost = 0;
     bool path_guided = false;
