@@ -148,7 +148,6 @@ core::MppiConfig mppi_config(const DaemonConfig& cfg) {
   c.contact_cost = m.contact_cost;
   c.guide_samples = m.guide_samples;
   c.path_guide = m.path_guide;
-  c.path.unsafe_cost = cfg.interactive_space.cost_threshold;  // R, as the rollouts'
   // The footprint can touch an obstacle closer than its circumscribed radius.
   const double footprint_x_m =
       std::max(std::abs(cfg.costmap.footprint_x_min_m), std::abs(cfg.costmap.footprint_x_max_m));

@@ -234,7 +234,8 @@ void BM_CostmapPath(benchmark::State& state) {
   const core::CostmapPathConfig config;
   core::CostmapPathResult r{};
   for (auto _ : state) {
-    r = planner.plan(map, {0.0, 0.0}, {3.0, 0.0}, config, path);
+    planner.set_map(map, 0.1);  // as the controller does, once per step
+    r = planner.plan({0.0, 0.0}, {3.0, 0.0}, config, path);
     benchmark::DoNotOptimize(path.data());
   }
   state.counters["found"] = r == core::CostmapPathResult::kFound ? 1 : 0;

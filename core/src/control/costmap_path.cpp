@@ -34,10 +34,10 @@ bool segment_crosses(const Costmap& map, Point2 a, Point2 b, double cost) {
   return false;
 }
 
-void CostmapPathPlanner::coarsen(const Costmap& map, int factor) {
+void CostmapPathPlanner::set_map(const Costmap& map, double cell_m) {
   const int fine = map.cells();
-  factor_ = factor;
-  n_ = (fine + factor - 1) / factor;
+  const int factor = std::max(1, static_cast<int>(std::lround(cell_m / map.resolution())));
+  n_ = fine > 0 ? (fine + factor - 1) / factor : 0;
   cell_m_ = map.resolution() * factor;
   ox_ = map.origin_x();
   oy_ = map.origin_y();
@@ -62,13 +62,12 @@ void CostmapPathPlanner::coarsen(const Costmap& map, int factor) {
   }
 }
 
-CostmapPathResult CostmapPathPlanner::plan(const Costmap& map, Point2 start, Point2 goal,
+CostmapPathResult CostmapPathPlanner::plan(Point2 start, Point2 goal,
                                            const CostmapPathConfig& config,
                                            std::vector<Point2>& path) {
   path.clear();
   expansions_ = 0;
-  if (map.cells() <= 0) return CostmapPathResult::kStartOffMap;
-  coarsen(map, std::max(1, static_cast<int>(std::lround(config.cell_m / map.resolution()))));
+  if (n_ <= 0) return CostmapPathResult::kStartOffMap;  // no map, or an empty one
   auto index_of = [&](Point2 p, int& i, int& j) {
     const double gx = (p.x_m - ox_) / cell_m_;
     const double gy = (p.y_m - oy_) / cell_m_;

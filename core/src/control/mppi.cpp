@@ -416,6 +416,7 @@ MppiOutput Mppi::step(const MppiInputs& in) {
     // it, on the robot's straight line to q^d now or on q^d's own way over the horizon (every
     // second): the steering law would run through them. The path goes round, to q^d at the end.
     CostmapPathConfig path_config = cfg_.path;
+    path_config.unsafe_cost = cfg_.cost_threshold;
     if (cfg_.contact_cost > 0.0) {
       path_config.blocked_cost = std::min(path_config.blocked_cost, cfg_.contact_threshold);
     }
@@ -437,10 +438,12 @@ MppiOutput Mppi::step(const MppiInputs& in) {
     auto plan_below = [&](double cost) {
       CostmapPathConfig c = path_config;
       c.blocked_cost = cost;
-      return planner_.plan(*in.costmap, from, {end.x, end.y}, c, path_) ==
-             CostmapPathResult::kFound;
+      return planner_.plan(from, {end.x, end.y}, c, path_) == CostmapPathResult::kFound;
     };
-    if (blocked && (plan_below(cfg_.cost_threshold) || plan_below(path_config.blocked_cost))) {
+    if (blocked) planner_.set_map(*in.costmap, cfg_.path_cell_m);
+    if (blocked &&
+        (plan_below(cfg_.cost_threshold) || (path_config.blocked_cost > cfg_.cost_threshold &&
+                                             plan_below(path_config.blocked_cost)))) {
       path_arc_.assign(1, 0.0);
       for (size_t i = 1; i < path_.size(); ++i) {
         path_arc_.push_back(path_arc_.back() + std::hypot(path_[i].x_m - path_[i - 1].x_m,

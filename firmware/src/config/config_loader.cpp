@@ -215,6 +215,10 @@ void check_relations(const DaemonConfig& cfg, const YAML::Node& root, const std:
           "the height band z_min_m..z_max_m must be above zero and at most 64 voxels high");
   require(cfg.costmap.inflation_radius_m >= cfg.costmap.inscribed_radius_m,
           "costmap.inflation_radius_m", "must be >= costmap.inscribed_radius_m");
+  // The path sample is lane 4 of the structured samples' block: without the block it would be
+  // silently ignored.
+  require(!cfg.mppi.path_guide || cfg.mppi.guide_samples, "mppi.path_guide",
+          "needs mppi.guide_samples: true (the path sample is one of the structured samples)");
   require(cfg.tracker.reconnect_max_ms >= cfg.tracker.reconnect_first_ms,
           "tracker.reconnect_max_ms",
           "must be >= tracker.reconnect_first_ms (" +

@@ -54,10 +54,11 @@ double length_of(const std::vector<Point2>& path) {
 TEST(CostmapPath, OnAnOpenFloorItIsTheStraightLine) {
   const core::Costmap map = map_with({});
   core::CostmapPathPlanner planner;
+  planner.set_map(map, 0.1);
   std::vector<Point2> path;
   const Point2 start{0.0, 0.0};
   const Point2 goal{3.0, 1.0};
-  ASSERT_EQ(planner.plan(map, start, goal, {}, path), CostmapPathResult::kFound);
+  ASSERT_EQ(planner.plan(start, goal, {}, path), CostmapPathResult::kFound);
   EXPECT_DOUBLE_EQ(path.front().x_m, start.x_m);
   EXPECT_DOUBLE_EQ(path.back().y_m, goal.y_m);
   // 8-connected on 0.1 m cells: the octile length (2 m straight + 1 m diagonal = 3.41 m), not
@@ -75,11 +76,12 @@ TEST(CostmapPath, GoesRoundAWallOnItsShortSide) {
   for (const double sign : {1.0, -1.0}) {
     const core::Costmap map = map_with({{{1.5, -0.4 * sign}, {1.5, 3.0 * sign}}});
     core::CostmapPathPlanner planner;
+    planner.set_map(map, 0.1);
     std::vector<Point2> path;
     const Point2 start{0.0, 0.0};
     const Point2 goal{3.0, 0.0};
     ASSERT_TRUE(core::segment_crosses(map, start, goal, core::kCostLethal));
-    ASSERT_EQ(planner.plan(map, start, goal, {}, path), CostmapPathResult::kFound);
+    ASSERT_EQ(planner.plan(start, goal, {}, path), CostmapPathResult::kFound);
     double crossing_y = 0;  // where the path passes the wall's line
     for (size_t i = 1; i < path.size(); ++i) {
       EXPECT_LT(map.at(path[i].x_m, path[i].y_m), core::kCostLethal) << i;
@@ -99,8 +101,9 @@ TEST(CostmapPath, PrefersFreeSpaceToTheUnsafeBand) {
   ASSERT_GE(map.cost(1.5, 0.0), 30.0);
   ASSERT_LT(map.at(1.5, 0.0), core::kCostLethal);
   core::CostmapPathPlanner planner;
+  planner.set_map(map, 0.1);
   std::vector<Point2> path;
-  ASSERT_EQ(planner.plan(map, {0.0, 0.0}, {3.0, 0.0}, {}, path), CostmapPathResult::kFound);
+  ASSERT_EQ(planner.plan({0.0, 0.0}, {3.0, 0.0}, {}, path), CostmapPathResult::kFound);
   bool through_gap = false;
   for (const Point2& p : path)
     through_gap = through_gap || (std::abs(p.x_m - 1.5) < 0.1 && std::abs(p.y_m) < 0.5);
@@ -109,7 +112,7 @@ TEST(CostmapPath, PrefersFreeSpaceToTheUnsafeBand) {
   core::CostmapPathConfig flat;
   flat.cost_weight = 0;
   flat.unsafe_penalty = 0;
-  ASSERT_EQ(planner.plan(map, {0.0, 0.0}, {3.0, 0.0}, flat, path), CostmapPathResult::kFound);
+  ASSERT_EQ(planner.plan({0.0, 0.0}, {3.0, 0.0}, flat, path), CostmapPathResult::kFound);
   through_gap = false;
   for (const Point2& p : path)
     through_gap = through_gap || (std::abs(p.x_m - 1.5) < 0.1 && std::abs(p.y_m) < 0.5);
@@ -123,23 +126,27 @@ TEST(CostmapPath, RefusesWhatItCannotPlan) {
                                       {{4.0, 1.0}, {2.0, 1.0}},
                                       {{2.0, 1.0}, {2.0, -1.0}}});
   core::CostmapPathPlanner planner;
+  planner.set_map(map, 0.1);
   std::vector<Point2> path{{9, 9}};
   core::CostmapPathConfig whole_map;  // 100 x 100 cells: the bound must not end it first
   whole_map.max_expansions = 20000;
-  EXPECT_EQ(planner.plan(map, {0.0, 0.0}, {3.0, 0.0}, whole_map, path), CostmapPathResult::kNoWay);
+  EXPECT_EQ(planner.plan({0.0, 0.0}, {3.0, 0.0}, whole_map, path), CostmapPathResult::kNoWay);
   EXPECT_TRUE(path.empty());
   core::CostmapPathConfig tight;
   tight.max_expansions = 50;
-  EXPECT_EQ(planner.plan(map, {0.0, 0.0}, {3.0, 0.0}, tight, path),
+  EXPECT_EQ(planner.plan({0.0, 0.0}, {3.0, 0.0}, tight, path),
             CostmapPathResult::kTooManyExpansions);
   EXPECT_LE(planner.expansions(), 51);
-  EXPECT_EQ(planner.plan(map, {0.0, 0.0}, {2.0, 0.0}, {}, path), CostmapPathResult::kGoalBlocked);
-  EXPECT_EQ(planner.plan(map, {0.0, 0.0}, {30.0, 0.0}, {}, path), CostmapPathResult::kGoalOffMap);
-  EXPECT_EQ(planner.plan(map, {-30.0, 0.0}, {0.5, 0.0}, {}, path), CostmapPathResult::kStartOffMap);
-  EXPECT_EQ(planner.plan(map, {std::nan(""), 0.0}, {0.5, 0.0}, {}, path),
+  EXPECT_EQ(planner.plan({0.0, 0.0}, {2.0, 0.0}, {}, path), CostmapPathResult::kGoalBlocked);
+  EXPECT_EQ(planner.plan({0.0, 0.0}, {30.0, 0.0}, {}, path), CostmapPathResult::kGoalOffMap);
+  EXPECT_EQ(planner.plan({-30.0, 0.0}, {0.5, 0.0}, {}, path), CostmapPathResult::kStartOffMap);
+  EXPECT_EQ(planner.plan({std::nan(""), 0.0}, {0.5, 0.0}, {}, path),
             CostmapPathResult::kStartOffMap);
-  EXPECT_EQ(planner.plan(core::Costmap{}, {0.0, 0.0}, {0.5, 0.0}, {}, path),
-            CostmapPathResult::kStartOffMap);
+  planner.set_map(core::Costmap{}, 0.1);  // an empty map
+  EXPECT_EQ(planner.plan({0.0, 0.0}, {0.5, 0.0}, {}, path), CostmapPathResult::kStartOffMap);
+  EXPECT_EQ(core::CostmapPathPlanner{}.plan({0.0, 0.0}, {0.5, 0.0}, {}, path),
+            CostmapPathResult::kStartOffMap)
+      << "no map set";
   EXPECT_STREQ(core::to_string(CostmapPathResult::kNoWay), "no way");
 }
 
@@ -149,12 +156,13 @@ TEST(CostmapPath, StartsFromABlockedCell) {
   const Point2 start{1.3, 1.0};  // 0.2 m from the wall: inside its lethal core
   ASSERT_EQ(map.at(start.x_m, start.y_m), core::kCostLethal);
   core::CostmapPathPlanner planner;
+  planner.set_map(map, 0.1);
   std::vector<Point2> path;
-  ASSERT_EQ(planner.plan(map, start, {0.0, 1.0}, {}, path), CostmapPathResult::kFound);
+  ASSERT_EQ(planner.plan(start, {0.0, 1.0}, {}, path), CostmapPathResult::kFound);
   EXPECT_LT(length_of(path), 1.6) << "straight out, away from the wall";
   EXPECT_LT(path[path.size() / 2].x_m, start.x_m);
   // Behind the wall, the way is out on the near side and round its short end, not through it.
-  ASSERT_EQ(planner.plan(map, start, {2.5, 1.0}, {}, path), CostmapPathResult::kFound);
+  ASSERT_EQ(planner.plan(start, {2.5, 1.0}, {}, path), CostmapPathResult::kFound);
   double least_y = 9;
   for (const Point2& p : path)
     least_y = std::min(least_y, p.y_m);

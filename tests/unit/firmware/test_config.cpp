@@ -188,6 +188,9 @@ TEST(Config, RelationsBetweenKeysAreChecked) {
   EXPECT_TRUE(
       load_config_text("tracker:\n  quality_bad_below: 120\n  quality_good_min: 120\n", "test.yaml")
           .ok());
+  expect_error(load_config_text("mppi:\n  guide_samples: false\n  path_guide: true\n", "test.yaml"),
+               3, "mppi.path_guide", "needs mppi.guide_samples: true");
+  EXPECT_TRUE(load_config_text("mppi:\n  path_guide: true\n", "test.yaml").ok());
 }
 
 TEST(Config, TrackerDeviceUriIsChecked) {

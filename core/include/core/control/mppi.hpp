@@ -83,7 +83,8 @@ struct MppiConfig {
   // too, and where the person passes close by an obstacle the law runs into it. Scored like the
   // others; becomes the plan only when it beats every random sample.
   bool path_guide = false;
-  CostmapPathConfig path;
+  CostmapPathConfig path;  // its unsafe_cost is cost_threshold (R), whatever it says
+  double path_cell_m = 0.1;
   double path_speed_mps = 1.0;  // 1.5 cut the corner round a wall end into the contact tier
   int threads = 2;
   uint64_t seed = 1;
