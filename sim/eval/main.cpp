@@ -38,6 +38,7 @@ struct Outcome {
   std::vector<double> control_ms;
   std::vector<double> policy_ms;
   double wall_s = 0;
+  sim::ControllerCounts controller;
 };
 
 struct MeanStd {
@@ -66,7 +67,9 @@ std::string csv_header() {
          "mean_person_distance_m,max_person_distance_m,longest_far_s,min_static_clearance_m,"
          "min_people_clearance_m,rms_jerk_mps3,stops,side_front,side_front_left,side_left,"
          "side_behind_left,side_behind,side_behind_right,side_right,side_front_right,"
-         "policy_p50_ms,policy_p99_ms,control_p50_ms,control_p99_ms,wall_s\n";
+         "policy_p50_ms,policy_p99_ms,control_p50_ms,control_p99_ms,wall_s,"
+         "control_steps,control_failures,qp_repairs,closing_limits,guided_plans,paths_planned,"
+         "path_guided_plans\n";
 }
 
 std::string csv_row(const Outcome& o, const std::string& scenario) {
@@ -78,14 +81,16 @@ std::string csv_row(const Outcome& o, const std::string& scenario) {
     sides += fmt::format(",{:.2f}", t);
   return fmt::format(
       "{},{},{},{},{},{},{},{:.2f},{:.2f},{:.3f},{:.3f},{:.4f},{:.4f},{:.4f},{:.3f},{:.3f},{:.3f},"
-      "{:.2f},{:.3f},{:.3f},{:.2f},{}{},{:.4f},{:.4f},{:.4f},{:.4f},{:.2f}\n",
+      "{:.2f},{:.3f},{:.3f},{:.2f},{}{},{:.4f},{:.4f},{:.4f},{:.4f},{:.2f},{},{},{},{},{},{},{}\n",
       o.trial.c->name, o.trial.method->name, o.trial.seed, scenario, m.success ? 1 : 0, failure,
       m.collision ? 1 : 0, m.duration_s, m.active_s, m.uncomfortable_s, m.inside_ellipse_s,
       m.rmse_ex_m, m.rmse_ey_m, m.rmse_etheta_rad, m.min_person_distance_m,
       m.mean_person_distance_m, m.max_person_distance_m, m.longest_far_s,
       std::min(m.min_static_clearance_m, 999.0), std::min(m.min_people_clearance_m, 999.0),
       m.rms_jerk, m.stops, sides, o.policy_p50_ms, o.policy_p99_ms, o.control_p50_ms,
-      o.control_p99_ms, o.wall_s);
+      o.control_p99_ms, o.wall_s, o.controller.steps, o.controller.failures, o.controller.repairs,
+      o.controller.closing_limits, o.controller.guided_plans, o.controller.paths_planned,
+      o.controller.path_guided_plans);
 }
 
 std::string causes_text(const std::map<std::string, int>& causes) {
@@ -282,6 +287,7 @@ int run(int argc, char** argv) {
       out.trial = t;
       out.m = r.metrics;
       out.wall_s = r.wall_s;
+      out.controller = r.controller;
       out.policy_p50_ms = sim::quantile(r.policy_ms, 0.5);
       out.policy_p99_ms = sim::quantile(r.policy_ms, 0.99);
       out.control_p50_ms = sim::quantile(r.control_ms, 0.5);

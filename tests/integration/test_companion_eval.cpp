@@ -3,8 +3,11 @@
 // recorded-pedestrian mode; clear refusals.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "support/child_process.hpp"
 #include "support/files.hpp"
@@ -20,6 +23,28 @@ size_t lines(const std::string& s) {
     n += c == '\n' ? 1 : 0;
   return n;
 }
+std::vector<std::string> split(const std::string& line, char sep) {
+  std::vector<std::string> out;
+  std::stringstream in(line);
+  for (std::string field; std::getline(in, field, sep);)
+    out.push_back(field);
+  return out;
+}
+// The named column of the CSV row starting with `prefix`, as a number (NaN when either is absent).
+double csv_value(const std::string& csv, const std::string& prefix, const std::string& column) {
+  std::stringstream in(csv);
+  std::string header;
+  std::getline(in, header);
+  const std::vector<std::string> names = split(header, ',');
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind(prefix, 0) != 0) continue;
+    const std::vector<std::string> fields = split(line, ',');
+    for (size_t i = 0; i < names.size() && i < fields.size(); ++i) {
+      if (names[i] == column) return std::stod(fields[i]);
+    }
+  }
+  return std::nan("");
+}
 }  // namespace
 
 TEST(CompanionEval, RunsCasesAndMethodsByNameAndWritesTablesCsvAndPlots) {
@@ -33,6 +58,17 @@ TEST(CompanionEval, RunsCasesAndMethodsByNameAndWritesTablesCsvAndPlots) {
   // corridor: 1 trial x 3 methods; crowd-5: 2 trials x 3 methods; plus the header.
   EXPECT_EQ(lines(csv), 1U + 3U + 6U) << csv;
   EXPECT_NE(csv.find("crowd-5,fixed_side,2,crowd-5-2,"), std::string::npos) << csv;
+  // The controller's counters per trial: MPPI ran at 100 Hz for most of the 8 s and its
+  // structured samples won some steps; the path sample is off by default; the PID follower
+  // has no QP repair and no samples.
+  EXPECT_GT(csv_value(csv, "corridor,objective,1,", "control_steps"), 400.0) << csv;
+  EXPECT_LE(csv_value(csv, "corridor,objective,1,", "control_steps"), 800.0) << csv;
+  EXPECT_GT(csv_value(csv, "corridor,objective,1,", "guided_plans"), 0.0) << csv;
+  EXPECT_EQ(csv_value(csv, "corridor,objective,1,", "paths_planned"), 0.0) << csv;
+  EXPECT_EQ(csv_value(csv, "corridor,objective,1,", "control_failures"), 0.0) << csv;
+  EXPECT_GT(csv_value(csv, "corridor,pid,1,", "control_steps"), 400.0) << csv;
+  EXPECT_EQ(csv_value(csv, "corridor,pid,1,", "qp_repairs"), 0.0) << csv;
+  EXPECT_EQ(csv_value(csv, "corridor,pid,1,", "guided_plans"), 0.0) << csv;
   const std::string md = slurp(out + "/summary.md");
   EXPECT_NE(md.find("## corridor (1 trial per method)"), std::string::npos) << md;
   EXPECT_NE(md.find("## crowd-5 (2 trials per method)"), std::string::npos) << md;

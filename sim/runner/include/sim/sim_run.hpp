@@ -41,12 +41,25 @@ struct SimRunOptions {
   std::string costmap_stem;
 };
 
+// The control task's counters at the end of a run (firmware::ControlStatus): how often the
+// controller's safety layers and structured samples acted, per trial.
+struct ControllerCounts {
+  uint64_t steps = 0;              // controller runs (MPPI or the PID follower)
+  uint64_t failures = 0;           // MPPI runs that failed numerically
+  uint64_t repairs = 0;            // first controls the DCBF QP repair changed
+  uint64_t closing_limits = 0;     // commands the closing-speed limit slowed
+  uint64_t guided_plans = 0;       // a structured sample was the plan
+  uint64_t paths_planned = 0;      // a costmap path was planned (mppi.path_guide)
+  uint64_t path_guided_plans = 0;  // ... and following it was the plan
+};
+
 struct SimRunResult {
   RunMetrics metrics;
   std::vector<RunSample> samples;
   std::vector<double> policy_ms;   // wall time of every policy-task run
   std::vector<double> control_ms;  // wall time of every control-task run
   std::vector<hal::CanFrame> can_out;
+  ControllerCounts controller;
   std::string final_status;
   double wall_s = 0;
 };
