@@ -148,6 +148,7 @@ core::MppiConfig mppi_config(const DaemonConfig& cfg) {
   c.contact_cost = m.contact_cost;
   c.guide_samples = m.guide_samples;
   c.path_guide = m.path_guide;
+  c.orbit_guide = m.orbit_guide;
   // The footprint can touch an obstacle closer than its circumscribed radius.
   const double footprint_x_m =
       std::max(std::abs(cfg.costmap.footprint_x_min_m), std::abs(cfg.costmap.footprint_x_max_m));
@@ -619,6 +620,8 @@ bool Daemon::run_controller(Nanos now, core::BodyVelocity& requested) {
   if (out.guided) ++control_state_.guided_plans;
   if (out.path_planned) ++control_state_.paths_planned;
   if (out.path_guided) ++control_state_.path_guided_plans;
+  if (out.orbit_planned) ++control_state_.orbits_planned;
+  if (out.orbit_guided) ++control_state_.orbit_guided_plans;
   control_state_.min_cost = out.min_cost;
   control_state_.best_cost = out.best;
   control_state_.effective_samples = out.effective_samples;

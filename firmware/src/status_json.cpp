@@ -98,6 +98,8 @@ std::string Daemon::build_status_json(core::Nanos now) const {
                     {"guided_plans", v.guided_plans},
                     {"paths_planned", v.paths_planned},
                     {"path_guided_plans", v.path_guided_plans},
+                    {"orbits_planned", v.orbits_planned},
+                    {"orbit_guided_plans", v.orbit_guided_plans},
                     {"effective_samples", number(v.effective_samples)},
                     {"min_cost", number(v.min_cost)},
                     {"best_cost",

@@ -105,17 +105,29 @@ def sweep_plot(prefix, rows, out):
 
 
 def first_samples(out_dir, case, rows):
+    """The first trial's samples per method, with its world (walls, obstacles) when written."""
     picked = {}
     for r in rows:
-        path = os.path.join(out_dir, "samples", case, f"{r['method']}-{r['seed']}.csv")
-        if r["method"] not in picked and os.path.exists(path):
-            picked[r["method"]] = read_csv(path)
+        stem = os.path.join(out_dir, "samples", case, f"{r['method']}-{r['seed']}")
+        if r["method"] not in picked and os.path.exists(stem + ".csv"):
+            world = read_csv(stem + "-world.csv") if os.path.exists(stem + "-world.csv") else []
+            picked[r["method"]] = (read_csv(stem + ".csv"), world)
     return picked
+
+
+def draw_world(ax, world):
+    for w in world:
+        a, b, c, d = (float(w[k]) if w[k] else 0.0 for k in ("a", "b", "c", "d"))
+        if w["kind"] == "segment":
+            ax.plot([a, c], [b, d], color="#555555", linewidth=1.5)
+        elif w["kind"] == "circle":
+            ax.add_patch(plt.Circle((a, b), c, color="#555555", alpha=0.8))
 
 
 def trajectories_plot(case, samples, out):
     fig, axes = plt.subplots(1, len(samples), figsize=(4.2 * len(samples), 4.2), squeeze=False)
-    for ax, (method, s) in zip(axes[0], sorted(samples.items())):
+    for ax, (method, (s, world)) in zip(axes[0], sorted(samples.items())):
+        draw_world(ax, world)
         ax.plot([float(x["person_x_m"]) for x in s], [float(x["person_y_m"]) for x in s],
                 color="#1f5fbf", label="person")
         ax.plot([float(x["robot_x_m"]) for x in s], [float(x["robot_y_m"]) for x in s],
@@ -123,6 +135,12 @@ def trajectories_plot(case, samples, out):
         g = [x for x in s if x["has_goal"] == "1" and x["active"] == "1"]
         ax.scatter([float(x["goal_x_m"]) for x in g[::3]], [float(x["goal_y_m"]) for x in g[::3]],
                    s=4, color="#2a9d3a", label="q^d")
+        # The walk's extent (the world's walls may run far beyond it).
+        xs = [float(x[k]) for x in s for k in ("person_x_m", "robot_x_m")]
+        ys = [float(x[k]) for x in s for k in ("person_y_m", "robot_y_m")]
+        if xs:
+            ax.set_xlim(min(xs) - 3.0, max(xs) + 3.0)
+            ax.set_ylim(min(ys) - 3.0, max(ys) + 3.0)
         ax.set_aspect("equal")
         ax.set_title(method, fontsize=10)
         ax.grid(alpha=0.3)
@@ -135,7 +153,7 @@ def trajectories_plot(case, samples, out):
 
 def errors_plot(case, samples, out):
     fig, axes = plt.subplots(3, 1, figsize=(9, 6.5), sharex=True)
-    for method, s in sorted(samples.items()):
+    for method, (s, _) in sorted(samples.items()):
         t, ex, ey, et = [], [], [], []
         for x in s:
             if x["has_goal"] != "1" or x["active"] != "1":

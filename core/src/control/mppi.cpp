@@ -26,6 +26,25 @@ Twist clip(const Twist& u, const TwistLimits& l) {
                std::clamp(u.wz, -l.wz, l.wz)};
 }
 
+// How deep the segment from -> to runs into an ellipse (semi-axes a, b) centred at `centre` with
+// heading (c, s): the least normalised radius on it (1 on the ellipse, 0 at its centre). In
+// the ellipse's normalised frame the segment stays a segment and the ellipse a unit circle.
+double chord_depth(Point2 centre, double c, double s, const Ellipse& e, Point2 from, Point2 to) {
+  auto normalised = [&](Point2 p) {
+    const double dx = p.x_m - centre.x_m;
+    const double dy = p.y_m - centre.y_m;
+    return Point2{(c * dx + s * dy) / e.a_m, (-s * dx + c * dy) / e.b_m};
+  };
+  const Point2 p = normalised(from);
+  const Point2 q = normalised(to);
+  const double ux = q.x_m - p.x_m;
+  const double uy = q.y_m - p.y_m;
+  const double length2 = ux * ux + uy * uy;
+  const double t =
+      length2 > 0 ? std::clamp(-(p.x_m * ux + p.y_m * uy) / length2, 0.0, 1.0) : 0.0;
+  return std::hypot(p.x_m + t * ux, p.y_m + t * uy);
+}
+
 }  // namespace
 
 Mppi::Mppi(const MppiConfig& config)
@@ -201,6 +220,58 @@ void Mppi::prepare_guide_block(const MppiInputs& in) {
       carrot0 = carrot1;
     }
   };
+  // The orbit samples: the steering law on a carrot that goes round the person (`dir` +1
+  // counter-clockwise, -1 clockwise, seen from above) from the robot's bearing to q^d's, in the
+  // ellipse's normalised polar coordinates (rho 1 on the barrier's ellipse) of the person's
+  // predicted frame at each step, so it walks with them: out to orbit_radius, round at
+  // orbit_speed_mps, in to q^d over the last half radian.
+  auto orbit = [&](size_t lane, double dir) {
+    const double a = cfg_.ellipse.a_m;
+    const double b = cfg_.ellipse.b_m;
+    auto polar = [&](const PersonFrame& f, double x, double y, double& rho, double& phi) {
+      const double dx = x - f.x;
+      const double dy = y - f.y;
+      const double lx = (f.c * dx + f.s * dy) / a;
+      const double ly = (-f.s * dx + f.c * dy) / b;
+      rho = std::hypot(lx, ly);
+      phi = std::atan2(ly, lx);
+    };
+    double rho_robot = 0;
+    double phi_robot = 0;
+    polar(person_frames_.front(), in.robot.x_m, in.robot.y_m, rho_robot, phi_robot);
+    const double omega =
+        cfg_.orbit_speed_mps / (cfg_.orbit_radius * std::sqrt(0.5 * (a * a + b * b)));
+    constexpr double kLandingRad = 0.5;
+    auto carrot_at = [&](size_t k) {
+      const PersonFrame& f = person_frames_[std::min(k, person_frames_.size() - 1)];
+      const GoalFrame& g = goal_frames_[std::min(k, goal_frames_.size() - 1)];
+      double rho_goal = 0;
+      double phi_goal = 0;
+      polar(f, g.x, g.y, rho_goal, phi_goal);
+      double to_go = wrap_angle(phi_goal - phi_robot);
+      if (dir > 0 && to_go < 0) to_go += 2.0 * std::numbers::pi;
+      if (dir < 0 && to_go > 0) to_go -= 2.0 * std::numbers::pi;
+      const double travelled = std::min(omega * dt * static_cast<double>(k), std::abs(to_go));
+      const double left = std::abs(to_go) - travelled;
+      const double phi = phi_robot + dir * travelled;
+      const double landing = std::clamp(left / kLandingRad, 0.0, 1.0);
+      const double rho = rho_goal + (cfg_.orbit_radius - rho_goal) * landing;
+      const double lx = rho * a * std::cos(phi);
+      const double ly = rho * b * std::sin(phi);
+      return Point2{f.x + f.c * lx - f.s * ly, f.y + f.s * lx + f.c * ly};
+    };
+    Pose2 p = in.robot;
+    Twist prev = in.current;
+    Point2 carrot0 = carrot_at(0);
+    for (size_t k = 0; k < horizon; ++k) {
+      const Point2 carrot1 = carrot_at(k + 1);
+      const Twist u = law(k, p, prev, 1.0, &carrot0, &carrot1);
+      put(lane, k, u);
+      p = advance(p, u);
+      prev = u;
+      carrot0 = carrot1;
+    }
+  };
   Twist brake = in.current;
   for (size_t k = 0; k < horizon; ++k) {
     put(0, k, mean_[k]);
@@ -215,7 +286,11 @@ void Mppi::prepare_guide_block(const MppiInputs& in) {
   }
   steer(2, 1.0);
   steer(3, 0.5);
-  if (structured_lanes_ > 4) follow(4);
+  if (path_lane_ != kNoLane) follow(path_lane_);
+  if (orbit_lane_ != kNoLane) {
+    orbit(orbit_lane_, 1.0);
+    orbit(orbit_lane_ + 1, -1.0);
+  }
 }
 
 void Mppi::rollout_block(size_t block, const MppiInputs& in) {
@@ -410,6 +485,8 @@ MppiOutput Mppi::step(const MppiInputs& in) {
     o = static_cast<uint32_t>(next_random(rng_state_) % kPoolSize) & ~uint32_t{kLanes - 1};
   }
   structured_lanes_ = 4;
+  path_lane_ = kNoLane;
+  orbit_lane_ = kNoLane;
   path_.clear();
   if (guide_block_ != SIZE_MAX && cfg_.path_guide && in.costmap != nullptr) {
     // Cells where the footprint would touch (the contact tier's), or the lethal core without
@@ -455,9 +532,17 @@ MppiOutput Mppi::step(const MppiInputs& in) {
                             std::hypot(goal_frames_[k].x - goal_frames_[k - 1].x,
                                        goal_frames_[k].y - goal_frames_[k - 1].y));
       }
-      structured_lanes_ = 5;
+      path_lane_ = structured_lanes_++;
       out.path_planned = true;
     }
+  }
+  if (guide_block_ != SIZE_MAX && cfg_.orbit_guide && !person_frames_.empty() &&
+      chord_depth({person_frames_.front().x, person_frames_.front().y}, person_frames_.front().c,
+                  person_frames_.front().s, cfg_.ellipse, {in.robot.x_m, in.robot.y_m},
+                  {goal_frames_.front().x, goal_frames_.front().y}) < cfg_.orbit_trigger_radius) {
+    orbit_lane_ = structured_lanes_;
+    structured_lanes_ += 2;
+    out.orbit_planned = true;
   }
   if (guide_block_ != SIZE_MAX) prepare_guide_block(in);
   const auto blocks = static_cast<int64_t>(offset_.size());
@@ -492,7 +577,10 @@ MppiOutput Mppi::step(const MppiInputs& in) {
   }
   const bool take_guide = guide_cost < min_cost;
   out.guided = take_guide;
-  out.path_guided = take_guide && guide % kLanes == 4 && structured_lanes_ > 4;
+  const size_t guide_lane = guide % kLanes;
+  out.path_guided = take_guide && guide_lane == path_lane_;
+  out.orbit_guided = take_guide && orbit_lane_ != kNoLane &&
+                     (guide_lane == orbit_lane_ || guide_lane == orbit_lane_ + 1);
   if (take_guide) best = guide;
   out.best.tracking = static_cast<double>(tracking_cost_[best]);
   out.best.collision = static_cast<double>(collision_cost_[best]);

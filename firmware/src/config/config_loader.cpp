@@ -219,6 +219,8 @@ void check_relations(const DaemonConfig& cfg, const YAML::Node& root, const std:
   // silently ignored.
   require(!cfg.mppi.path_guide || cfg.mppi.guide_samples, "mppi.path_guide",
           "needs mppi.guide_samples: true (the path sample is one of the structured samples)");
+  require(!cfg.mppi.orbit_guide || cfg.mppi.guide_samples, "mppi.orbit_guide",
+          "needs mppi.guide_samples: true (the orbit samples are structured samples)");
   require(cfg.tracker.reconnect_max_ms >= cfg.tracker.reconnect_first_ms,
           "tracker.reconnect_max_ms",
           "must be >= tracker.reconnect_first_ms (" +

@@ -838,6 +838,19 @@ std::vector<FieldSpec> build() {
        0,
        0,
        {}},
+      {"mppi.orbit_guide",
+       "bool",
+       "Two more structured samples, with mppi.guide_samples (not in the paper): when the "
+       "robot's straight line to q^d runs deep through the person's ellipse (q^d on their other "
+       "side), the steering law on a carrot that goes round the person at 1.15 times the "
+       "ellipse and 1 m/s, one sample each way, then onto q^d. The barrier forbids the straight "
+       "way and random samples about a plan that holds still do not reach round, so without "
+       "them the robot stays on the side it first took with q^d across the person. Counted in "
+       "control.orbits_planned and control.orbit_guided_plans. false: none.",
+       FIELD(mppi.orbit_guide),
+       0,
+       0,
+       {}},
       {"mppi.noise_vx_mps",
        "m/s",
        "Sigma: std-dev of the sampled forward-velocity noise (> 0: the control cost divides by "

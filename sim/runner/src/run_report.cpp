@@ -266,6 +266,17 @@ std::string samples_csv(const std::vector<RunSample>& samples) {
   return out;
 }
 
+std::string world_csv(const StaticWorld& world) {
+  std::string out = "kind,a,b,c,d\n";
+  for (const Segment& s : world.segments) {
+    out += fmt::format("segment,{:.3f},{:.3f},{:.3f},{:.3f}\n", s.a.x_m, s.a.y_m, s.b.x_m, s.b.y_m);
+  }
+  for (const Circle& c : world.circles) {
+    out += fmt::format("circle,{:.3f},{:.3f},{:.3f},\n", c.center.x_m, c.center.y_m, c.radius_m);
+  }
+  return out;
+}
+
 std::string write_run_report(const std::string& dir, const RunReportInputs& in) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
@@ -275,6 +286,7 @@ std::string write_run_report(const std::string& dir, const RunReportInputs& in) 
       {"metrics.json", metrics_json(in)},
       {"samples.csv", samples_csv(*in.samples)},
       {"trajectory.svg", trajectory_svg(in)},
+      {"world.csv", world_csv(in.scenario->world)},
   };
   for (const auto& [name, text] : files) {
     const std::string path = dir + "/" + name;

@@ -485,3 +485,49 @@ TEST(Mppi, ThePathSampleTakesTheShortWayRoundAWall) {
   EXPECT_LT(with_path.time_s, random_only.time_s - 1.5);
   EXPECT_LT(with_path.highest_cost, 71.0) << "the footprint never touches the wall";
 }
+
+// The person's other side (mppi.orbit_guide): a person standing still, the robot on their right
+// at the ellipse, q^d the point on their left (the fixed_side baseline's, on the ellipse).
+// Every straight way runs through the ellipse, which the barrier forbids; random samples about
+// a plan that holds still do not reach round it.
+TEST(Mppi, TheOrbitSampleGoesRoundThePersonToTheirOtherSide) {
+  struct Result {
+    double final_distance_m = 9, time_s = 99, min_h = 9;
+    bool orbit_guided = false;
+  };
+  auto run = [&](bool orbit) {
+    auto cfg = test_config();
+    cfg.guide_samples = true;
+    cfg.orbit_guide = orbit;
+    cfg.horizon_steps = 100;
+    cfg.samples = 2000;
+    cfg.min_effective_samples = 50;
+    cfg.limits = core::TwistLimits{1.8, 1.0, 2.0};
+    Loop loop(cfg);
+    loop.robot = Pose2{0.0, -0.8, 0.0};
+    const std::vector<Pose2> person(101, Pose2{0.0, 0.0, 0.0});
+    const Pose2 goal{0.0, 0.7, 0.0};
+    Result r;
+    for (int i = 0; i < 600; ++i) {
+      const auto out = loop.tick(goal, person, nullptr);
+      EXPECT_TRUE(out.ok);
+      r.orbit_guided = r.orbit_guided || out.orbit_guided;
+      r.min_h = std::min(r.min_h, core::barrier(person.front(), {loop.robot.x_m, loop.robot.y_m},
+                                                cfg.ellipse));
+      r.final_distance_m = std::hypot(loop.robot.x_m - goal.x_m, loop.robot.y_m - goal.y_m);
+      if (r.final_distance_m < 0.2 && r.time_s > 90) r.time_s = 0.01 * i;
+    }
+    return r;
+  };
+  const Result random_only = run(false);
+  const Result with_orbit = run(true);
+  std::printf("distance to q^d after 6 s / time to 0.2 m: without %.2f m / %.2f s, with %.2f m / "
+              "%.2f s\n",
+              random_only.final_distance_m, random_only.time_s, with_orbit.final_distance_m,
+              with_orbit.time_s);
+  EXPECT_FALSE(random_only.orbit_guided);
+  EXPECT_GT(random_only.final_distance_m, 1.0) << "stuck on the wrong side";
+  EXPECT_TRUE(with_orbit.orbit_guided);
+  EXPECT_LT(with_orbit.final_distance_m, 0.2) << "round to q^d";
+  EXPECT_GE(with_orbit.min_h, -0.02) << "round the ellipse, not through it";
+}

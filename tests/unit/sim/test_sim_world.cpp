@@ -620,6 +620,23 @@ TEST(RunMetrics, SamplesCarryTheDaemonsCommandAndPlanCostsToDiagnoseATrial) {
   EXPECT_NE(csv.find(",0.750,-0.250,nan,nan,nan\n"), std::string::npos) << csv;
 }
 
+TEST(RunReport, WorldCsvListsEveryWallAndObstacleForThePlots) {
+  sim::StaticWorld w;
+  w.add_wall({0, -1}, {4, -1});
+  w.add_box({1, 1}, {2, 1.5});  // four segments
+  w.add_circle({3, 0.5}, 0.25);
+  const std::string csv = sim::world_csv(w);
+  EXPECT_EQ(csv.rfind("kind,a,b,c,d\nsegment,0.000,-1.000,4.000,-1.000\n", 0), 0U) << csv;
+  EXPECT_NE(csv.find("\ncircle,3.000,0.500,0.250,\n"), std::string::npos) << csv;
+  size_t segments = 0;
+  for (size_t at = csv.find("\nsegment,"); at != std::string::npos;
+       at = csv.find("\nsegment,", at + 1)) {
+    ++segments;
+  }
+  EXPECT_EQ(segments, 5U) << csv;
+  EXPECT_EQ(sim::world_csv(sim::StaticWorld{}), "kind,a,b,c,d\n");
+}
+
 // ---- costmap snapshots (companion-eval --costmap-at) ------------------------------------------
 
 namespace {

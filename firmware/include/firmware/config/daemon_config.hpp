@@ -143,6 +143,7 @@ struct DaemonConfig {
     double contact_cost = 0;  // 0: off
     bool guide_samples = false;
     bool path_guide = false;
+    bool orbit_guide = false;
     double noise_vx_mps = 0;
     double noise_vy_mps = 0;
     double noise_wz_radps = 0;

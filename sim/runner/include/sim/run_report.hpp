@@ -7,6 +7,7 @@
 
 #include "sim/run_metrics.hpp"
 #include "sim/scenario.hpp"
+#include "sim/static_world.hpp"
 
 namespace sim {
 
@@ -26,6 +27,9 @@ std::string trajectory_svg(const RunReportInputs& in);
 std::string report_markdown(const RunReportInputs& in);
 std::string metrics_json(const RunReportInputs& in);
 std::string samples_csv(const std::vector<RunSample>& samples);
+// The world's fixed geometry for plots, one shape a row (world frame, m):
+// `segment,x0,y0,x1,y1` (walls, polygon edges) and `circle,x,y,r` (round obstacles).
+std::string world_csv(const StaticWorld& world);
 
 // Writes report.md, metrics.json, samples.csv and trajectory.svg into `dir` (created). Returns ""
 // or what went wrong.

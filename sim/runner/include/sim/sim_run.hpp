@@ -51,6 +51,8 @@ struct ControllerCounts {
   uint64_t guided_plans = 0;       // a structured sample was the plan
   uint64_t paths_planned = 0;      // a costmap path was planned (mppi.path_guide)
   uint64_t path_guided_plans = 0;  // ... and following it was the plan
+  uint64_t orbits_planned = 0;     // q^d across the person: orbit samples ran (orbit_guide)
+  uint64_t orbit_guided_plans = 0;  // ... and one was the plan
 };
 
 struct SimRunResult {
