@@ -81,7 +81,8 @@ std::string csv_row(const Outcome& o, const std::string& scenario) {
     sides += fmt::format(",{:.2f}", t);
   return fmt::format(
       "{},{},{},{},{},{},{},{:.2f},{:.2f},{:.3f},{:.3f},{:.4f},{:.4f},{:.4f},{:.3f},{:.3f},{:.3f},"
-      "{:.2f},{:.3f},{:.3f},{:.2f},{}{},{:.4f},{:.4f},{:.4f},{:.4f},{:.2f},{},{},{},{},{},{},{},{},{}\n",
+      "{:.2f},{:.3f},{:.3f},{:.2f},{}{},{:.4f},{:.4f},{:.4f},{:.4f},{:.2f},{},{},{},{},{},{},{},{},"
+      "{}\n",
       o.trial.c->name, o.trial.method->name, o.trial.seed, scenario, m.success ? 1 : 0, failure,
       m.collision ? 1 : 0, m.duration_s, m.active_s, m.uncomfortable_s, m.inside_ellipse_s,
       m.rmse_ex_m, m.rmse_ey_m, m.rmse_etheta_rad, m.min_person_distance_m,

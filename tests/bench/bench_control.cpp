@@ -275,6 +275,40 @@ void BM_MppiStepPathGuide(benchmark::State& state) {
 }
 BENCHMARK(BM_MppiStepPathGuide)->ArgName("path")->Arg(0)->Arg(1)->Apply(one_step_percentiles);
 
+// A full controller step as shipped (1 thread) with q^d across the person: a person standing at
+// the origin, the robot on their right at the ellipse, q^d on their left. `orbit` 0 without the
+// orbit samples (the baseline in the same run), 1 with them (the chord test and two more
+// steering-law integrations every step).
+void BM_MppiStepOrbitGuide(benchmark::State& state) {
+  core::MppiConfig cfg = firmware::mppi_config(*firmware::load_default_config().config);
+  cfg.threads = 1;
+  cfg.orbit_guide = state.range(0) != 0;
+  core::Mppi mppi(cfg);
+  const std::vector<core::Pose2> person(static_cast<size_t>(cfg.horizon_steps) + 1,
+                                        core::Pose2{0.0, 0.0, 0.0});
+  core::MppiInputs in;
+  in.robot = core::Pose2{0.0, -0.8, 0.0};
+  in.goal = core::Pose2{0.0, 0.7, 0.0};
+  in.person = person;
+  core::Nanos t{0};
+  for (int i = 0; i < 20; ++i) {  // warm up
+    in.now = t;
+    in.current = mppi.step(in).command;
+    t += 10ms;
+  }
+  bool planned = false;
+  for (auto _ : state) {
+    in.now = t;
+    const auto out = mppi.step(in);
+    benchmark::DoNotOptimize(out);
+    planned = out.orbit_planned;
+    in.current = out.command;
+    t += 10ms;
+  }
+  state.counters["orbit_planned"] = planned ? 1 : 0;
+}
+BENCHMARK(BM_MppiStepOrbitGuide)->ArgName("orbit")->Arg(0)->Arg(1)->Apply(one_step_percentiles);
+
 // The paper's policy step: W, P, G, the observation (layout 1, 716 floats) and the MLP
 // 716 -> 256 -> 128 -> 64 -> 64 (ReLU), masked argmax. Random weights: the cost is the same.
 void BM_PolicyStep(benchmark::State& state) {

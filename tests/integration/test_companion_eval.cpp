@@ -77,8 +77,9 @@ TEST(CompanionEval, RunsCasesAndMethodsByNameAndWritesTablesCsvAndPlots) {
   EXPECT_NE(md.find("trials/min"), std::string::npos);
   EXPECT_FALSE(slurp(out + "/samples/corridor/objective-1.csv").empty());
   // The corridor's walls beside the samples, for the trajectory plot.
-  EXPECT_EQ(slurp(out + "/samples/corridor/objective-1-world.csv").rfind("kind,a,b,c,d\nsegment,", 0),
-            0U);
+  EXPECT_EQ(
+      slurp(out + "/samples/corridor/objective-1-world.csv").rfind("kind,a,b,c,d\nsegment,", 0),
+      0U);
 
   ChildProcess plot({"/usr/bin/python3", COMPANION_PLOT_SCRIPT, out});
   ASSERT_TRUE(plot.started());

@@ -40,8 +40,7 @@ double chord_depth(Point2 centre, double c, double s, const Ellipse& e, Point2 f
   const double ux = q.x_m - p.x_m;
   const double uy = q.y_m - p.y_m;
   const double length2 = ux * ux + uy * uy;
-  const double t =
-      length2 > 0 ? std::clamp(-(p.x_m * ux + p.y_m * uy) / length2, 0.0, 1.0) : 0.0;
+  const double t = length2 > 0 ? std::clamp(-(p.x_m * ux + p.y_m * uy) / length2, 0.0, 1.0) : 0.0;
   return std::hypot(p.x_m + t * ux, p.y_m + t * uy);
 }
 

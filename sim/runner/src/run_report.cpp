@@ -282,10 +282,8 @@ std::string write_run_report(const std::string& dir, const RunReportInputs& in) 
   std::filesystem::create_directories(dir, ec);
   if (ec) return fmt::format("cannot create {}: {}", dir, ec.message());
   const std::pair<const char*, std::string> files[] = {
-      {"report.md", report_markdown(in)},
-      {"metrics.json", metrics_json(in)},
-      {"samples.csv", samples_csv(*in.samples)},
-      {"trajectory.svg", trajectory_svg(in)},
+      {"report.md", report_markdown(in)},           {"metrics.json", metrics_json(in)},
+      {"samples.csv", samples_csv(*in.samples)},    {"trajectory.svg", trajectory_svg(in)},
       {"world.csv", world_csv(in.scenario->world)},
   };
   for (const auto& [name, text] : files) {

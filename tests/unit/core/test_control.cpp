@@ -494,6 +494,7 @@ TEST(Mppi, TheOrbitSampleGoesRoundThePersonToTheirOtherSide) {
   struct Result {
     double final_distance_m = 9, time_s = 99, min_h = 9;
     bool orbit_guided = false;
+    bool planned_at_end = true;  // q^d still across the person at the last step
   };
   auto run = [&](bool orbit) {
     auto cfg = test_config();
@@ -512,8 +513,9 @@ TEST(Mppi, TheOrbitSampleGoesRoundThePersonToTheirOtherSide) {
       const auto out = loop.tick(goal, person, nullptr);
       EXPECT_TRUE(out.ok);
       r.orbit_guided = r.orbit_guided || out.orbit_guided;
-      r.min_h = std::min(r.min_h, core::barrier(person.front(), {loop.robot.x_m, loop.robot.y_m},
-                                                cfg.ellipse));
+      r.planned_at_end = out.orbit_planned;
+      r.min_h = std::min(
+          r.min_h, core::barrier(person.front(), {loop.robot.x_m, loop.robot.y_m}, cfg.ellipse));
       r.final_distance_m = std::hypot(loop.robot.x_m - goal.x_m, loop.robot.y_m - goal.y_m);
       if (r.final_distance_m < 0.2 && r.time_s > 90) r.time_s = 0.01 * i;
     }
@@ -521,13 +523,15 @@ TEST(Mppi, TheOrbitSampleGoesRoundThePersonToTheirOtherSide) {
   };
   const Result random_only = run(false);
   const Result with_orbit = run(true);
-  std::printf("distance to q^d after 6 s / time to 0.2 m: without %.2f m / %.2f s, with %.2f m / "
-              "%.2f s\n",
-              random_only.final_distance_m, random_only.time_s, with_orbit.final_distance_m,
-              with_orbit.time_s);
+  std::printf(
+      "distance to q^d after 6 s / time to 0.2 m: without %.2f m / %.2f s, with %.2f m / "
+      "%.2f s\n",
+      random_only.final_distance_m, random_only.time_s, with_orbit.final_distance_m,
+      with_orbit.time_s);
   EXPECT_FALSE(random_only.orbit_guided);
   EXPECT_GT(random_only.final_distance_m, 1.0) << "stuck on the wrong side";
   EXPECT_TRUE(with_orbit.orbit_guided);
   EXPECT_LT(with_orbit.final_distance_m, 0.2) << "round to q^d";
   EXPECT_GE(with_orbit.min_h, -0.02) << "round the ellipse, not through it";
+  EXPECT_FALSE(with_orbit.planned_at_end) << "at q^d the orbit samples no longer run";
 }
