@@ -93,10 +93,10 @@ struct MppiConfig {
   // the ellipse and orbit_speed_mps, then onto q^d. The barrier forbids the straight way and
   // random samples about a plan that holds still do not reach round: the robot stays on the
   // side it first took, with q^d across the person (the fixed_side baseline's e_y of ~1 m).
-  bool orbit_guide = false;
   double orbit_trigger_radius = 0.85;
   double orbit_radius = 1.15;
   double orbit_speed_mps = 1.0;
+  bool orbit_guide = false;  // (after its parameters: beside `threads`, no padding)
   int threads = 2;
   uint64_t seed = 1;
 };
