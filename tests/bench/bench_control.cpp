@@ -277,8 +277,8 @@ BENCHMARK(BM_MppiStepPathGuide)->ArgName("path")->Arg(0)->Arg(1)->Apply(one_step
 
 // A full controller step as shipped (1 thread) with q^d across the person: a person standing at
 // the origin, the robot on their right at the ellipse, q^d on their left. `orbit` 0 without the
-// orbit samples (the baseline in the same run), 1 with them (the chord test and two more
-// steering-law integrations every step).
+// orbit sample (the baseline in the same run), 1 with it (the chord test and one more
+// steering-law integration every step).
 void BM_MppiStepOrbitGuide(benchmark::State& state) {
   core::MppiConfig cfg = firmware::mppi_config(*firmware::load_default_config().config);
   cfg.threads = 1;

@@ -498,10 +498,10 @@ TEST(ClosedLoop, PathGuideIsPlannedThroughTheDaemonAndCounted) {
 
 // mppi.orbit_guide through the daemon: the fixed_side baseline in the corridor, the robot
 // starting 1 m straight behind the person and q^d the point on their left. Without the orbit
-// samples the robot takes the right side and stays there for the whole walk, q^d 1.5 m across
-// the person (the baseline's e_y of ~1 m in docs/EVALUATION.md); with them it goes round to the
-// left. The status counts the steps with q^d across the person and those where an orbit sample
-// became the plan; off, neither moves. (Core:
+// sample the robot takes the right side and stays there for the whole walk, q^d 1.5 m across
+// the person (the baseline's e_y of ~1 m in docs/EVALUATION.md); with it the robot goes round
+// their back to the left. The status counts the steps with q^d across the person and those
+// where the orbit sample became the plan; off, neither moves. (Core:
 // Mppi.TheOrbitSampleGoesRoundThePersonToTheirOtherSide.)
 TEST(ClosedLoop, OrbitGuideTakesTheRobotRoundThePersonAndIsCounted) {
   struct Result {

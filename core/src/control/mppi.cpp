@@ -219,12 +219,13 @@ void Mppi::prepare_guide_block(const MppiInputs& in) {
       carrot0 = carrot1;
     }
   };
-  // The orbit samples: the steering law on a carrot that goes round the person (`dir` +1
-  // counter-clockwise, -1 clockwise, seen from above) from the robot's bearing to q^d's, in the
-  // ellipse's normalised polar coordinates (rho 1 on the barrier's ellipse) of the person's
-  // predicted frame at each step, so it walks with them: out to orbit_radius, round at
-  // orbit_speed_mps, in to q^d over the last half radian.
-  auto orbit = [&](size_t lane, double dir) {
+  // The orbit sample: the steering law on a carrot that goes round the person from the robot's
+  // bearing to q^d's, the way that does not pass in front of them (where a walking person goes:
+  // the first version went either way, and round the front lost two random validation trials
+  // in 80 to a person turning back), in the ellipse's normalised polar coordinates (rho 1 on
+  // the barrier's ellipse) of the person's predicted frame at each step, so it walks with them:
+  // out to orbit_radius, round at orbit_speed_mps, in to q^d over the last half radian.
+  auto orbit = [&](size_t lane) {
     const double a = cfg_.ellipse.a_m;
     const double b = cfg_.ellipse.b_m;
     auto polar = [&](const PersonFrame& f, double x, double y, double& rho, double& phi) {
@@ -238,6 +239,16 @@ void Mppi::prepare_guide_block(const MppiInputs& in) {
     double rho_robot = 0;
     double phi_robot = 0;
     polar(person_frames_.front(), in.robot.x_m, in.robot.y_m, rho_robot, phi_robot);
+    double rho_goal0 = 0;
+    double phi_goal0 = 0;
+    polar(person_frames_.front(), goal_frames_.front().x, goal_frames_.front().y, rho_goal0,
+          phi_goal0);
+    // +1 counter-clockwise seen from above. On one side of the person: straight along it; from
+    // one side to the other: round the back (through phi = pi).
+    const bool robot_left = phi_robot >= 0.0;
+    const double dir = robot_left == (phi_goal0 >= 0.0) ? (phi_goal0 >= phi_robot ? 1.0 : -1.0)
+                       : robot_left                     ? 1.0
+                                                        : -1.0;
     const double omega =
         cfg_.orbit_speed_mps / (cfg_.orbit_radius * std::sqrt(0.5 * (a * a + b * b)));
     constexpr double kLandingRad = 0.5;
@@ -286,10 +297,7 @@ void Mppi::prepare_guide_block(const MppiInputs& in) {
   steer(2, 1.0);
   steer(3, 0.5);
   if (path_lane_ != kNoLane) follow(path_lane_);
-  if (orbit_lane_ != kNoLane) {
-    orbit(orbit_lane_, 1.0);
-    orbit(orbit_lane_ + 1, -1.0);
-  }
+  if (orbit_lane_ != kNoLane) orbit(orbit_lane_);
 }
 
 void Mppi::rollout_block(size_t block, const MppiInputs& in) {
@@ -539,8 +547,7 @@ MppiOutput Mppi::step(const MppiInputs& in) {
       chord_depth({person_frames_.front().x, person_frames_.front().y}, person_frames_.front().c,
                   person_frames_.front().s, cfg_.ellipse, {in.robot.x_m, in.robot.y_m},
                   {goal_frames_.front().x, goal_frames_.front().y}) < cfg_.orbit_trigger_radius) {
-    orbit_lane_ = structured_lanes_;
-    structured_lanes_ += 2;
+    orbit_lane_ = structured_lanes_++;
     out.orbit_planned = true;
   }
   if (guide_block_ != SIZE_MAX) prepare_guide_block(in);
@@ -578,8 +585,7 @@ MppiOutput Mppi::step(const MppiInputs& in) {
   out.guided = take_guide;
   const size_t guide_lane = guide % kLanes;
   out.path_guided = take_guide && guide_lane == path_lane_;
-  out.orbit_guided = take_guide && orbit_lane_ != kNoLane &&
-                     (guide_lane == orbit_lane_ || guide_lane == orbit_lane_ + 1);
+  out.orbit_guided = take_guide && guide_lane == orbit_lane_;
   if (take_guide) best = guide;
   out.best.tracking = static_cast<double>(tracking_cost_[best]);
   out.best.collision = static_cast<double>(collision_cost_[best]);

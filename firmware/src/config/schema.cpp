@@ -840,13 +840,13 @@ std::vector<FieldSpec> build() {
        {}},
       {"mppi.orbit_guide",
        "bool",
-       "Two more structured samples, with mppi.guide_samples (not in the paper): when the "
+       "One more structured sample, with mppi.guide_samples (not in the paper): when the "
        "robot's straight line to q^d runs deep through the person's ellipse (q^d on their other "
-       "side), the steering law on a carrot that goes round the person at 1.15 times the "
-       "ellipse and 1 m/s, one sample each way, then onto q^d. The barrier forbids the straight "
-       "way and random samples about a plan that holds still do not reach round, so without "
-       "them the robot stays on the side it first took with q^d across the person. Counted in "
-       "control.orbits_planned and control.orbit_guided_plans. false: none.",
+       "side), the steering law on a carrot that goes round the person's back (never in front "
+       "of them) at 1.15 times the ellipse and 1 m/s, then onto q^d. The barrier forbids the "
+       "straight way and random samples about a plan that holds still do not reach round, so "
+       "without it the robot stays on the side it first took with q^d across the person. "
+       "Counted in control.orbits_planned and control.orbit_guided_plans. false: none.",
        FIELD(mppi.orbit_guide),
        0,
        0,

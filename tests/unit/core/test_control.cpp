@@ -533,5 +533,5 @@ TEST(Mppi, TheOrbitSampleGoesRoundThePersonToTheirOtherSide) {
   EXPECT_TRUE(with_orbit.orbit_guided);
   EXPECT_LT(with_orbit.final_distance_m, 0.2) << "round to q^d";
   EXPECT_GE(with_orbit.min_h, -0.02) << "round the ellipse, not through it";
-  EXPECT_FALSE(with_orbit.planned_at_end) << "at q^d the orbit samples no longer run";
+  EXPECT_FALSE(with_orbit.planned_at_end) << "at q^d the orbit sample no longer runs";
 }

@@ -86,13 +86,14 @@ struct MppiConfig {
   CostmapPathConfig path;  // its unsafe_cost is cost_threshold (R), whatever it says
   double path_cell_m = 0.1;
   double path_speed_mps = 1.0;  // 1.5 cut the corner round a wall end into the contact tier
-  // Two more structured samples (with guide_samples; not in the paper): when the robot's straight
+  // One more structured sample (with guide_samples; not in the paper): when the robot's straight
   // line to q^d runs deep through the person's ellipse (q^d on their other side: the chord's
   // nearest point inside orbit_trigger_radius of the ellipse, in its normalised radius), the
-  // steering law on a carrot that goes round the person, one each way, at orbit_radius times
-  // the ellipse and orbit_speed_mps, then onto q^d. The barrier forbids the straight way and
-  // random samples about a plan that holds still do not reach round: the robot stays on the
-  // side it first took, with q^d across the person (the fixed_side baseline's e_y of ~1 m).
+  // steering law on a carrot that goes round the person, round their back (never in front of
+  // them), at orbit_radius times the ellipse and orbit_speed_mps, then onto q^d. The barrier
+  // forbids the straight way and random samples about a plan that holds still do not reach round:
+  // the robot stays on the side it first took, with q^d across the person (the fixed_side
+  // baseline's e_y of ~1 m).
   double orbit_trigger_radius = 0.85;
   double orbit_radius = 1.15;
   double orbit_speed_mps = 1.0;
@@ -133,8 +134,8 @@ struct MppiOutput {
   bool guided = false;           // a structured sample beat every random one and became the plan
   bool path_planned = false;     // an obstacle lay on the line to q^d and a path round it was found
   bool path_guided = false;      // ... and its sample became the plan
-  bool orbit_planned = false;    // q^d lay across the person's ellipse: the orbit samples ran
-  bool orbit_guided = false;     // ... and one of them became the plan
+  bool orbit_planned = false;    // q^d lay across the person's ellipse: the orbit sample ran
+  bool orbit_guided = false;     // ... and it became the plan
   double min_cost = 0;           // best sample's cost
   MppiCostTerms best;            // ... by term
   double effective_samples = 0;  // 1 / sum(w^2): how many samples carried the update
@@ -171,12 +172,12 @@ class Mppi {
   size_t guide_block_ = SIZE_MAX;
   std::vector<float> guide_noise_;
   // Lanes 0 .. structured_lanes_ - 1 of the guide block are structured (not averaged in): 4,
-  // then the path sample when a path was planned this step, then the two orbit samples when q^d
-  // is across the person; their lanes (kNoLane: none this step).
+  // then the path sample when a path was planned this step, then the orbit sample when q^d is
+  // across the person; their lanes (kNoLane: none this step).
   static constexpr size_t kNoLane = SIZE_MAX;
   size_t structured_lanes_ = 4;
   size_t path_lane_ = kNoLane;
-  size_t orbit_lane_ = kNoLane;  // and orbit_lane_ + 1: counter-clockwise, then clockwise
+  size_t orbit_lane_ = kNoLane;
   CostmapPathPlanner planner_;
   std::vector<Point2> path_;      // robot -> q^d round the obstacles; empty: no path sample
   std::vector<double> path_arc_;  // arc length along path_ at each of its points
