@@ -243,6 +243,28 @@ void BM_CostmapPath(benchmark::State& state) {
 }
 BENCHMARK(BM_CostmapPath)->ArgName("closed")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
+// Warms the controller up (20 steps at 100 Hz), then times one step per iteration; the counter
+// `name` says whether the last timed step had `flag` set (the option under test acted).
+void time_steps(benchmark::State& state, core::Mppi& mppi, core::MppiInputs& in,
+                bool core::MppiOutput::*flag, const char* name) {
+  core::Nanos t{0};
+  for (int i = 0; i < 20; ++i) {
+    in.now = t;
+    in.current = mppi.step(in).command;
+    t += 10ms;
+  }
+  bool acted = false;
+  for (auto _ : state) {
+    in.now = t;
+    const auto out = mppi.step(in);
+    benchmark::DoNotOptimize(out);
+    acted = out.*flag;
+    in.current = out.command;
+    t += 10ms;
+  }
+  state.counters[name] = acted ? 1 : 0;
+}
+
 // A full controller step as shipped (guide samples, contact tier, effective-sample floor; 1
 // thread) with the wall on the line to q^d: `path` 0 without the path sample (the baseline in
 // the same run), 1 with it (the straight-line test, a path planned every step, a ninth
@@ -256,22 +278,7 @@ void BM_MppiStepPathGuide(benchmark::State& state) {
   core::MppiInputs in;
   in.goal = core::Pose2{3.0, 0.0, 0.0};
   in.costmap = &map;
-  core::Nanos t{0};
-  for (int i = 0; i < 20; ++i) {  // warm up
-    in.now = t;
-    in.current = mppi.step(in).command;
-    t += 10ms;
-  }
-  bool planned = false;
-  for (auto _ : state) {
-    in.now = t;
-    const auto out = mppi.step(in);
-    benchmark::DoNotOptimize(out);
-    planned = out.path_planned;
-    in.current = out.command;
-    t += 10ms;
-  }
-  state.counters["path_planned"] = planned ? 1 : 0;
+  time_steps(state, mppi, in, &core::MppiOutput::path_planned, "path_planned");
 }
 BENCHMARK(BM_MppiStepPathGuide)->ArgName("path")->Arg(0)->Arg(1)->Apply(one_step_percentiles);
 
@@ -290,22 +297,7 @@ void BM_MppiStepOrbitGuide(benchmark::State& state) {
   in.robot = core::Pose2{0.0, -0.8, 0.0};
   in.goal = core::Pose2{0.0, 0.7, 0.0};
   in.person = person;
-  core::Nanos t{0};
-  for (int i = 0; i < 20; ++i) {  // warm up
-    in.now = t;
-    in.current = mppi.step(in).command;
-    t += 10ms;
-  }
-  bool planned = false;
-  for (auto _ : state) {
-    in.now = t;
-    const auto out = mppi.step(in);
-    benchmark::DoNotOptimize(out);
-    planned = out.orbit_planned;
-    in.current = out.command;
-    t += 10ms;
-  }
-  state.counters["orbit_planned"] = planned ? 1 : 0;
+  time_steps(state, mppi, in, &core::MppiOutput::orbit_planned, "orbit_planned");
 }
 BENCHMARK(BM_MppiStepOrbitGuide)->ArgName("orbit")->Arg(0)->Arg(1)->Apply(one_step_percentiles);
 

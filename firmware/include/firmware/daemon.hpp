@@ -120,10 +120,10 @@ struct ControlStatus {
   uint64_t closing_limits = 0;  // commands slowed toward the person (closing_speed.*)
   uint64_t guided_plans = 0;    // steps where a structured sample became the plan (guide_samples)
   uint64_t paths_planned = 0;   // steps with a costmap path round an obstacle (path_guide)
-  uint64_t path_guided_plans = 0;  // ... where the path sample became the plan
-  uint64_t orbits_planned = 0;  // steps with q^d across the person's ellipse (orbit_guide)
+  uint64_t path_guided_plans = 0;   // ... where the path sample became the plan
+  uint64_t orbits_planned = 0;      // steps with q^d across the person's ellipse (orbit_guide)
   uint64_t orbit_guided_plans = 0;  // ... where an orbit sample became the plan
-  core::BodyVelocity command;      // after the supervisor's gate (what went to the base)
+  core::BodyVelocity command;       // after the supervisor's gate (what went to the base)
 };
 
 // "front", "left", "behind", "right" of the person, from the design point's angle.

@@ -191,8 +191,9 @@ TEST(Config, RelationsBetweenKeysAreChecked) {
   expect_error(load_config_text("mppi:\n  guide_samples: false\n  path_guide: true\n", "test.yaml"),
                3, "mppi.path_guide", "needs mppi.guide_samples: true");
   EXPECT_TRUE(load_config_text("mppi:\n  path_guide: true\n", "test.yaml").ok());
-  expect_error(load_config_text("mppi:\n  guide_samples: false\n  orbit_guide: true\n", "test.yaml"),
-               3, "mppi.orbit_guide", "needs mppi.guide_samples: true");
+  expect_error(
+      load_config_text("mppi:\n  guide_samples: false\n  orbit_guide: true\n", "test.yaml"), 3,
+      "mppi.orbit_guide", "needs mppi.guide_samples: true");
   EXPECT_TRUE(load_config_text("mppi:\n  orbit_guide: true\n", "test.yaml").ok());
 }
 

@@ -44,14 +44,14 @@ struct SimRunOptions {
 // The control task's counters at the end of a run (firmware::ControlStatus): how often the
 // controller's safety layers and structured samples acted, per trial.
 struct ControllerCounts {
-  uint64_t steps = 0;              // controller runs (MPPI or the PID follower)
-  uint64_t failures = 0;           // MPPI runs that failed numerically
-  uint64_t repairs = 0;            // first controls the DCBF QP repair changed
-  uint64_t closing_limits = 0;     // commands the closing-speed limit slowed
-  uint64_t guided_plans = 0;       // a structured sample was the plan
-  uint64_t paths_planned = 0;      // a costmap path was planned (mppi.path_guide)
-  uint64_t path_guided_plans = 0;  // ... and following it was the plan
-  uint64_t orbits_planned = 0;     // q^d across the person: orbit samples ran (orbit_guide)
+  uint64_t steps = 0;               // controller runs (MPPI or the PID follower)
+  uint64_t failures = 0;            // MPPI runs that failed numerically
+  uint64_t repairs = 0;             // first controls the DCBF QP repair changed
+  uint64_t closing_limits = 0;      // commands the closing-speed limit slowed
+  uint64_t guided_plans = 0;        // a structured sample was the plan
+  uint64_t paths_planned = 0;       // a costmap path was planned (mppi.path_guide)
+  uint64_t path_guided_plans = 0;   // ... and following it was the plan
+  uint64_t orbits_planned = 0;      // q^d across the person: orbit samples ran (orbit_guide)
   uint64_t orbit_guided_plans = 0;  // ... and one was the plan
 };
 
