@@ -110,6 +110,18 @@ core::TrackerConfidence to_tracker_confidence(amfitrack::Confidence c) {
   return core::TrackerConfidence::kUnknown;
 }
 
+core::ClosingSpeedConfig closing_speed_config(const DaemonConfig& cfg) {
+  core::ClosingSpeedConfig c;
+  c.robot_decel_mps2 = cfg.closing_speed.robot_decel_mps2;
+  c.person_accel_mps2 = cfg.closing_speed.person_accel_mps2;
+  c.reaction_time_s = cfg.closing_speed.reaction_time_s;
+  c.margin_m = cfg.closing_speed.margin_m;
+  c.person_radius_m = cfg.closing_speed.person_radius_m;
+  c.footprint = core::Footprint{cfg.costmap.footprint_x_min_m, cfg.costmap.footprint_x_max_m,
+                                cfg.costmap.footprint_y_min_m, cfg.costmap.footprint_y_max_m};
+  return c;
+}
+
 core::InteractiveSpaceConfig interactive_space_config(const DaemonConfig& cfg) {
   core::InteractiveSpaceConfig c;
   c.points = static_cast<int>(cfg.interactive_space.points);
@@ -120,6 +132,8 @@ core::InteractiveSpaceConfig interactive_space_config(const DaemonConfig& cfg) {
   c.beta = cfg.objective.beta;
   c.gamma = cfg.objective.gamma;
   c.delta = cfg.objective.delta;
+  c.speed_standoff = cfg.interactive_space.speed_standoff;
+  c.closing = closing_speed_config(cfg);
   return c;
 }
 
@@ -163,14 +177,7 @@ core::MppiConfig mppi_config(const DaemonConfig& cfg) {
   c.ellipse = core::Ellipse{cfg.interactive_space.ellipse_a_m, cfg.interactive_space.ellipse_b_m};
   c.limits =
       core::TwistLimits{cfg.limits.vx_max_mps, cfg.limits.vy_max_mps, cfg.limits.wz_max_radps};
-  c.closing.robot_decel_mps2 = cfg.closing_speed.robot_decel_mps2;
-  c.closing.person_accel_mps2 = cfg.closing_speed.person_accel_mps2;
-  c.closing.reaction_time_s = cfg.closing_speed.reaction_time_s;
-  c.closing.margin_m = cfg.closing_speed.margin_m;
-  c.closing.person_radius_m = cfg.closing_speed.person_radius_m;
-  c.closing.footprint =
-      core::Footprint{cfg.costmap.footprint_x_min_m, cfg.costmap.footprint_x_max_m,
-                      cfg.costmap.footprint_y_min_m, cfg.costmap.footprint_y_max_m};
+  c.closing = closing_speed_config(cfg);
   c.linear_accel_mps2 = cfg.limits.linear_accel_max_mps2;
   c.angular_accel_radps2 = cfg.limits.angular_accel_max_radps2;
   c.threads = static_cast<int>(m.threads);
@@ -461,7 +468,7 @@ void Daemon::policy_task(const core::Tick& tick) {
     const core::HumanState h =
         core::human_state(track->value, tick.now, robot_odom, human_config_,
                           th ? th->value.confidence : core::TrackerConfidence::kUnknown);
-    space_.update(h.pose_base, robot_odom, *map);
+    space_.update(h.pose_base, robot_odom, *map, h.velocity_base);
     core::Selection s = core::select_by_objective(space_);
     if (selector_ == Selector::kFixedBehind || selector_ == Selector::kFixedSide) {
       // Evaluation baselines: one point of W, free or not (phi = pi behind, pi/2 the left side).

@@ -18,19 +18,24 @@ double person_approach_m(double time_s, double receding_mps, double speed_mps, d
   return start * ramp_s + 0.5 * accel_mps2 * ramp_s * ramp_s + cap * (time_s - ramp_s);
 }
 
-double max_closing_speed(double gap_m, double receding_mps, double speed_mps,
-                         const ClosingSpeedConfig& c) {
+double stopping_distance_m(double closing_mps, double receding_mps, double speed_mps,
+                           const ClosingSpeedConfig& c) {
+  // The robot at v stops after T = t + v / a, having moved v t + v^2 / (2 a) toward the person;
+  // meanwhile they come person_approach_m(T) closer.
   const double a = c.robot_decel_mps2;
   const double t = c.reaction_time_s;
+  const double v = closing_mps;
+  return v * t + v * v / (2.0 * a) +
+         person_approach_m(t + v / a, receding_mps, speed_mps, c.person_accel_mps2);
+}
+
+double max_closing_speed(double gap_m, double receding_mps, double speed_mps,
+                         const ClosingSpeedConfig& c) {
   const double room_m = std::max(gap_m - c.margin_m, 0.0);
-  // The robot at v stops after T = t + v / a, having moved v t + v^2 / (2 a) toward the person;
-  // meanwhile they come person_approach_m(T) closer. Both are convex in v (the person's speed
-  // toward the robot only grows), so the speeds that keep the sum within the room are [0, v_max].
-  auto closed_m = [&](double v) {
-    return v * t + v * v / (2.0 * a) +
-           person_approach_m(t + v / a, receding_mps, speed_mps, c.person_accel_mps2);
-  };
-  if (a <= 0.0 || closed_m(0.0) > room_m) return 0.0;
+  // Both terms of stopping_distance_m are convex in v (the person's speed toward the robot only
+  // grows), so the speeds that keep the sum within the room are [0, v_max].
+  auto closed_m = [&](double v) { return stopping_distance_m(v, receding_mps, speed_mps, c); };
+  if (c.robot_decel_mps2 <= 0.0 || closed_m(0.0) > room_m) return 0.0;
   double lo = 0.0;
   double hi = 4.0;
   for (int i = 0; i < 16 && closed_m(hi) <= room_m; ++i) {
@@ -42,6 +47,39 @@ double max_closing_speed(double gap_m, double receding_mps, double speed_mps,
     (closed_m(mid) <= room_m ? lo : hi) = mid;
   }
   return lo;
+}
+
+double follow_standoff_m(const Point2& toward_person, const Point2& person_velocity,
+                         const ClosingSpeedConfig& c) {
+  const double norm = std::hypot(toward_person.x_m, toward_person.y_m);
+  if (c.robot_decel_mps2 <= 0.0 || norm < 1e-9) return 0.0;
+  const double ux = toward_person.x_m / norm;
+  const double uy = toward_person.y_m / norm;
+  // Keeping pace, the robot closes at the speed the person recedes: the limit lets it when the
+  // gap holds what both need to stop from there (a person walking toward the point needs none).
+  const double receding = ux * person_velocity.x_m + uy * person_velocity.y_m;
+  if (receding <= 0.0) return 0.0;
+  const double speed = std::hypot(person_velocity.x_m, person_velocity.y_m);
+  const double body_gap_m =
+      c.person_radius_m + c.margin_m + stopping_distance_m(receding, receding, speed, c);
+  // The nearest the person's centre may be to the footprint box, along the ray: the box is
+  // convex, so its distance to the ray's points grows with the distance along it (bisection).
+  const Footprint& f = c.footprint;
+  auto box_distance = [&](double d) {
+    const double x = d * ux;
+    const double y = d * uy;
+    const double dx = std::max({f.x_min_m - x, 0.0, x - f.x_max_m});
+    const double dy = std::max({f.y_min_m - y, 0.0, y - f.y_max_m});
+    return std::hypot(dx, dy);
+  };
+  double lo = 0.0;
+  double hi = std::hypot(std::max(-f.x_min_m, f.x_max_m), std::max(-f.y_min_m, f.y_max_m)) +
+              body_gap_m;  // the box's far corner plus the gap: always far enough
+  for (int i = 0; i < 40; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (box_distance(mid) < body_gap_m ? lo : hi) = mid;
+  }
+  return hi;
 }
 
 ClosingSpeedResult limit_closing_speed(const Point2& person_in_base,

@@ -34,15 +34,35 @@ InteractiveSpace::InteractiveSpace(const InteractiveSpaceConfig& config)
 }
 
 void InteractiveSpace::update(const Pose2& person_base, const Pose2& robot_odom,
-                              const Costmap& costmap) {
+                              const Costmap& costmap, const Point2& person_velocity_base) {
   free_count_ = 0;
+  // The person's velocity in their own frame: a robot at a point of W faces their heading, so
+  // its axes are theirs.
+  const double c_h = std::cos(person_base.theta_rad);
+  const double s_h = std::sin(person_base.theta_rad);
+  const Point2 velocity_person{c_h * person_velocity_base.x_m + s_h * person_velocity_base.y_m,
+                               -s_h * person_velocity_base.x_m + c_h * person_velocity_base.y_m};
   for (size_t i = 0; i < candidates_.size(); ++i) {
     Candidate& c = candidates_[i];
-    const Point2 p = person_base.apply(point_in_person(i));
+    // G weighs the design point (the paper's W): the standoff below moves the diagonal points
+    // behind out farther than the one straight behind (the footprint's corner is nearer the
+    // person there), and alpha < 0 would then prefer them.
+    const Point2 design = person_base.apply(point_in_person(i));
+    c.dist_human_m = std::hypot(design.x_m - person_base.x_m, design.y_m - person_base.y_m);
+    c.dist_robot_m = std::hypot(design.x_m, design.y_m);
+    Point2 in_person = point_in_person(i);
+    if (config_.speed_standoff) {
+      const double d = std::hypot(in_person.x_m, in_person.y_m);
+      const double standoff =
+          follow_standoff_m({-in_person.x_m, -in_person.y_m}, velocity_person, config_.closing);
+      if (d > 1e-9 && standoff > d) {
+        in_person = {in_person.x_m * standoff / d, in_person.y_m * standoff / d};
+      }
+    }
+    // Where the robot is to be, and where it must be free.
+    const Point2 p = person_base.apply(in_person);
     c.base = Pose2{p.x_m, p.y_m, person_base.theta_rad};
     c.odom = robot_odom.apply(p);
-    c.dist_human_m = std::hypot(p.x_m - person_base.x_m, p.y_m - person_base.y_m);
-    c.dist_robot_m = std::hypot(p.x_m, p.y_m);
     c.cost = costmap.at(c.odom.x_m, c.odom.y_m);
     const double ahead_of_person_m = std::max(0.0, config_.a_m * cos_phi_[i]);
     c.objective = config_.alpha * c.dist_human_m + config_.beta * c.dist_robot_m +

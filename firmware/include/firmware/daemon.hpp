@@ -132,6 +132,7 @@ const char* side_of_person(int index, int points);
 // point `index` of n, and its name.
 int side_sector(int index, int points);
 const char* side_name(int sector);
+core::ClosingSpeedConfig closing_speed_config(const DaemonConfig& cfg);
 core::InteractiveSpaceConfig interactive_space_config(const DaemonConfig& cfg);
 // The learned selector's weights named by policy.file, checked against this configuration (n,
 // the observation layout). No file configured: no policy and no error.

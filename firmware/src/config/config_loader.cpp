@@ -221,6 +221,9 @@ void check_relations(const DaemonConfig& cfg, const YAML::Node& root, const std:
           "needs mppi.guide_samples: true (the path sample is one of the structured samples)");
   require(!cfg.mppi.orbit_guide || cfg.mppi.guide_samples, "mppi.orbit_guide",
           "needs mppi.guide_samples: true (the orbit samples are structured samples)");
+  require(!cfg.interactive_space.speed_standoff || cfg.closing_speed.robot_decel_mps2 > 0.0,
+          "interactive_space.speed_standoff",
+          "needs closing_speed.robot_decel_mps2 > 0 (the standoff is the limit's gap)");
   require(cfg.tracker.reconnect_max_ms >= cfg.tracker.reconnect_first_ms,
           "tracker.reconnect_max_ms",
           "must be >= tracker.reconnect_first_ms (" +

@@ -651,6 +651,19 @@ std::vector<FieldSpec> build() {
        1.0,
        100.0,
        {}},
+      {"interactive_space.speed_standoff",
+       "bool",
+       "Not in the paper: a point of W nearer the person than the robot can follow them under "
+       "the closing-speed limit (the gap it needs to stop from keeping pace with them, with "
+       "closing_speed.*) is moved out along its ray to that distance before it is costed and "
+       "chosen: at 1 m/s the point straight behind is 1.08 m back instead of a = 1.0 m; beside "
+       "and ahead of the person nothing moves. The robot is held there by the limit anyway; with "
+       "q^d there too, e measures tracking rather than the safety gap. Needs "
+       "closing_speed.robot_decel_mps2 > 0. false: the paper's fixed ellipse.",
+       FIELD(interactive_space.speed_standoff),
+       0,
+       0,
+       {}},
       {"policy.file",
        "path",
        "Learned selector (policy file, format in core/include/core/policy/mlp_policy.hpp). Empty: "

@@ -188,7 +188,7 @@ void FollowEnv::observe(std::span<float> observation, std::span<bool> mask) {
   human_.velocity_odom = {person_v_.x_m + vel(rng_), person_v_.y_m + vel(rng_)};
   human_.velocity_base = core::Pose2{0, 0, robot_.theta_rad}.inverse().apply(human_.velocity_odom);
   human_.yaw_rate_radps = person_w_;
-  space_.update(human_.pose_base, robot_, costmap_);
+  space_.update(human_.pose_base, robot_, costmap_, human_.velocity_base);
 
   core::ObservationInputs in;
   in.space = &space_;

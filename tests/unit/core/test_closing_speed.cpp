@@ -180,3 +180,41 @@ TEST(ClosingSpeed, ADrivingRobotStopsShortOfAStandingPerson) {
   EXPECT_GT(run(1.0), 0.0);
   EXPECT_LT(run(0.0), 0.0) << "without the limit the robot reaches them";
 }
+
+// follow_standoff_m: the nearest the robot may follow a walking person and still keep their pace
+// under the limit. Checked against limit_closing_speed itself: a robot at the standoff moving
+// with the person is not slowed; 2 cm nearer it is.
+TEST(ClosingSpeed, TheFollowStandoffIsWhereTheLimitLetsTheRobotKeepPace) {
+  const ClosingSpeedConfig c = on(1.0);
+  const Point2 walking{1.0, 0.0};  // 1 m/s along the robot's +x (the robot behind them)
+  const double standoff = core::follow_standoff_m({1.0, 0.0}, walking, c);
+  // front face 0.35 + body 0.25 + margin 0.1 + reaction 0.05 + braking 0.5 - their stop 1/6
+  EXPECT_NEAR(standoff, 0.35 + 0.25 + 0.10 + 0.05 + 0.5 - 1.0 / 6.0, 1e-6);
+  const Twist keep_pace{1.0, 0.0, 0.0};
+  EXPECT_FALSE(
+      core::limit_closing_speed({standoff + 1e-6, 0.0}, walking, keep_pace, c, kLimits).limited);
+  EXPECT_TRUE(
+      core::limit_closing_speed({standoff - 0.02, 0.0}, walking, keep_pace, c, kLimits).limited);
+  // Faster, farther: at 1.5 m/s the point behind needs ~1.5 m.
+  const double fast = core::follow_standoff_m({1.0, 0.0}, {1.5, 0.0}, c);
+  EXPECT_GT(fast, standoff + 0.4);
+  EXPECT_FALSE(
+      core::limit_closing_speed({fast + 1e-6, 0.0}, {1.5, 0.0}, {1.5, 0, 0}, c, kLimits).limited);
+  // Diagonally behind (the person ahead-left, walking along +x): the box's front-left corner is
+  // nearest, so the ray's distance is checked against the limit's own geometry (the limit
+  // measures the person's recession along the nearest point's normal, the standoff along the
+  // ray: within 3 cm).
+  const Point2 diagonal{std::cos(0.5), std::sin(0.5)};
+  const double d = core::follow_standoff_m(diagonal, walking, c);
+  const Point2 at{diagonal.x_m * (d + 0.03), diagonal.y_m * (d + 0.03)};
+  const Point2 near{diagonal.x_m * (d - 0.03), diagonal.y_m * (d - 0.03)};
+  EXPECT_FALSE(core::limit_closing_speed(at, walking, keep_pace, c, kLimits).limited);
+  EXPECT_TRUE(core::limit_closing_speed(near, walking, keep_pace, c, kLimits).limited);
+  EXPECT_GT(d, standoff) << "the footprint's corner is nearer the person than its front face";
+  // Beside a walking person, ahead of one (they walk toward the robot), beside a standing one,
+  // or with the limit off: the limit never holds a pacing robot back there.
+  EXPECT_DOUBLE_EQ(core::follow_standoff_m({0.0, 1.0}, walking, c), 0.0);
+  EXPECT_DOUBLE_EQ(core::follow_standoff_m({-1.0, 0.0}, walking, c), 0.0);
+  EXPECT_DOUBLE_EQ(core::follow_standoff_m({1.0, 0.0}, {0.0, 0.0}, c), 0.0);
+  EXPECT_DOUBLE_EQ(core::follow_standoff_m({1.0, 0.0}, walking, ClosingSpeedConfig{}), 0.0);
+}

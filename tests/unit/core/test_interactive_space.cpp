@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <numbers>
 
 #include "core/perception/costmap.hpp"
@@ -239,6 +240,55 @@ TEST(InteractiveSpace, ANegativeAlphaPullsADiagonalFollowerTowardStraightBehind)
   EXPECT_GT(aside_m(1.0), 0.3) << "alpha = 1: diagonally behind-right";
   EXPECT_LT(aside_m(-16.0), 0.25) << "alpha = -16: nearer straight behind";
   EXPECT_GT(aside_m(-16.0), 0.0) << "still on the robot's side of the track";
+}
+
+TEST(InteractiveSpace, SpeedStandoffMovesOutOnlyThePointsTheRobotCannotHoldAtThePersonsPace) {
+  // The person 2 m ahead and 0.5 m left of the robot, facing and walking left (+y in base_link)
+  // at 1 m/s; the robot's odom pose turned, so base_link, odom and the person's frame all differ.
+  const core::Pose2 person{2.0, 0.5, pi / 2};
+  const core::Point2 walking_base{0.0, 1.0};
+  const core::Pose2 robot_odom{1.0, -0.5, 0.3};
+  core::InteractiveSpaceConfig cfg;  // 64 points: 32 straight behind, 16 on the left, 0 ahead
+  cfg.closing.robot_decel_mps2 = 1.0;
+  const double standoff = core::follow_standoff_m({1.0, 0.0}, {1.0, 0.0}, cfg.closing);
+  ASSERT_NEAR(standoff, 1.083, 0.001);
+  auto run = [&](bool on, const core::Point2& velocity) {
+    core::InteractiveSpaceConfig c = cfg;
+    c.speed_standoff = on;
+    auto w = std::make_unique<core::InteractiveSpace>(c);
+    w->update(person, robot_odom, room(std::nullopt), velocity);
+    return w;
+  };
+  const auto paper = run(false, walking_base);
+  const auto on = run(true, walking_base);
+  const auto standing = run(true, {0.0, 0.0});
+  // The candidate's distance from the person (G keeps the design point's: dist_human_m).
+  auto from_person = [&](const core::InteractiveSpace& w, size_t i) {
+    const core::Pose2& b = w.candidates()[i].base;
+    return std::hypot(b.x_m - person.x_m, b.y_m - person.y_m);
+  };
+  const auto behind = on->candidates()[32];
+  EXPECT_NEAR(from_person(*on, 32), standoff, 1e-9);
+  EXPECT_NEAR(from_person(*paper, 32), cfg.a_m, 1e-9);
+  // Along the ray straight behind: in base_link that is -y from the person; odom moved with it.
+  EXPECT_NEAR(behind.base.x_m, person.x_m, 1e-9);
+  EXPECT_NEAR(behind.base.y_m, person.y_m - standoff, 1e-9);
+  const core::Point2 behind_odom = robot_odom.apply({behind.base.x_m, behind.base.y_m});
+  EXPECT_NEAR(behind.odom.x_m, behind_odom.x_m, 1e-9);
+  EXPECT_NEAR(behind.odom.y_m, behind_odom.y_m, 1e-9);
+  // G is the paper's: the same for every point with the standoff as without (an empty room).
+  for (size_t i = 0; i < 64; ++i) {
+    EXPECT_DOUBLE_EQ(on->candidates()[i].objective, paper->candidates()[i].objective) << i;
+  }
+  // Diagonally behind: moved out (farther than straight behind: the footprint's corner is
+  // nearer the person); beside, ahead, and every point of a standing person: not.
+  EXPECT_GT(from_person(*on, 24), from_person(*paper, 24) + 0.1);
+  for (const size_t i : {0U, 8U, 16U, 48U, 56U}) {
+    EXPECT_NEAR(from_person(*on, i), from_person(*paper, i), 1e-12) << i;
+  }
+  for (size_t i = 0; i < 64; ++i) {
+    EXPECT_NEAR(from_person(*standing, i), from_person(*paper, i), 1e-12) << i;
+  }
 }
 
 }  // namespace

@@ -195,6 +195,11 @@ TEST(Config, RelationsBetweenKeysAreChecked) {
       load_config_text("mppi:\n  guide_samples: false\n  orbit_guide: true\n", "test.yaml"), 3,
       "mppi.orbit_guide", "needs mppi.guide_samples: true");
   EXPECT_TRUE(load_config_text("mppi:\n  orbit_guide: true\n", "test.yaml").ok());
+  expect_error(load_config_text("closing_speed:\n  robot_decel_mps2: 0\ninteractive_space:\n"
+                                "  speed_standoff: true\n",
+                                "test.yaml"),
+               4, "interactive_space.speed_standoff", "needs closing_speed.robot_decel_mps2 > 0");
+  EXPECT_TRUE(load_config_text("interactive_space:\n  speed_standoff: true\n", "test.yaml").ok());
 }
 
 TEST(Config, TrackerDeviceUriIsChecked) {
@@ -231,6 +236,9 @@ TEST(Config, ControllerParametersComeFromTheConfigurationAsInThePaper) {
   const auto w = firmware::interactive_space_config(*firmware::load_default_config().config);
   EXPECT_EQ(w.points, 64);
   EXPECT_DOUBLE_EQ(w.cost_threshold, 30.0);
+  EXPECT_FALSE(w.speed_standoff);
+  EXPECT_DOUBLE_EQ(w.closing.robot_decel_mps2, c.closing.robot_decel_mps2) << "the limit's own";
+  EXPECT_DOUBLE_EQ(w.closing.footprint.x_max_m, c.closing.footprint.x_max_m);
   // The shipped weights of G are the core defaults, whose behaviour test_interactive_space pins
   // (InteractiveSpace.DefaultWeightsSendALaggingRobotBehindThePersonNotBesideThem): changing
   // either alone fails here.

@@ -53,8 +53,22 @@ struct ClosingSpeedResult {
 // `accel_mps2`.
 double person_approach_m(double time_s, double receding_mps, double speed_mps, double accel_mps2);
 
+// How much the gap closes (m) from a command closing at `closing_mps` until the robot has
+// stopped: its reaction and braking, plus person_approach_m over that time.
+double stopping_distance_m(double closing_mps, double receding_mps, double speed_mps,
+                           const ClosingSpeedConfig& c);
+
 // The largest speed toward the person that still stops in time (>= 0).
 double max_closing_speed(double gap_m, double receding_mps, double speed_mps,
+                         const ClosingSpeedConfig& c);
+
+// The nearest the robot's centre may follow the person's centre (m) and still keep pace under
+// the limit: a robot on the ray `toward_person` (its own axes; any length), moving with the
+// person (`person_velocity`, the same axes), closes at the speed they recede, which the limit
+// allows only with a gap of margin + stopping_distance_m. 0 when the person does not recede
+// from that side (beside or ahead of them: the limit does not hold the robot back) or the limit
+// is off. At 1 m/s straight behind, with the defaults: 1.08 m (the ellipse's a: 1.0 m).
+double follow_standoff_m(const Point2& toward_person, const Point2& person_velocity,
                          const ClosingSpeedConfig& c);
 
 // `person_in_base` and `person_velocity_in_base` (the person's own velocity, base_link axes).

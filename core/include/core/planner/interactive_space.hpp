@@ -15,6 +15,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/control/closing_speed.hpp"
 #include "core/geometry/pose2.hpp"
 #include "core/perception/costmap.hpp"
 
@@ -29,29 +30,40 @@ struct InteractiveSpaceConfig {
   double beta = 4.0;             // weight of the distance to the robot (= the shipped yaml)
   double gamma = 0.02;           // weight of the costmap cost
   double delta = 4.0;            // weight of how far the point is ahead of the person (ours)
+  // Ours: when true, a point of W nearer the person than the robot may follow them under the
+  // closing-speed limit (follow_standoff_m with `closing`, at the person's velocity) is moved
+  // out along its ray to that distance: its cost, whether it is free, and q^d are taken there;
+  // G's distance terms stay the design point's (the selection is the paper's). The robot is
+  // held there anyway; q^d there makes e measure tracking, not the safety gap, and keeps the
+  // controller from pulling against the limit. false: the paper's fixed ellipse.
+  bool speed_standoff = false;
+  ClosingSpeedConfig closing;
 };
 
 struct Candidate {
-  Pose2 base;   // in base_link; theta = the person's heading
-  Point2 odom;  // where the costmap is looked up
-  double dist_human_m = 0;
-  double dist_robot_m = 0;
-  double cost = 0;       // l(q), 0..100
-  double objective = 0;  // G
-  bool free = false;     // in P
+  Pose2 base;   // in base_link; theta = the person's heading (speed_standoff: moved out)
+  Point2 odom;  // where the costmap is looked up (the same point)
+  double dist_human_m = 0;  // of the design point (G's terms)
+  double dist_robot_m = 0;  // of the design point
+  double cost = 0;          // l(q), 0..100
+  double objective = 0;     // G
+  bool free = false;        // in P
 };
 
 class InteractiveSpace {
  public:
   explicit InteractiveSpace(const InteractiveSpaceConfig& config);
 
-  // W and P for the person (base_link) seen from the robot (its pose in odom, for the costmap).
-  void update(const Pose2& person_base, const Pose2& robot_odom, const Costmap& costmap);
+  // W and P for the person (base_link) seen from the robot (its pose in odom, for the costmap);
+  // `person_velocity_base`: their velocity in base_link axes (used by speed_standoff only).
+  void update(const Pose2& person_base, const Pose2& robot_odom, const Costmap& costmap,
+              const Point2& person_velocity_base = {});
 
   [[nodiscard]] std::span<const Candidate> candidates() const { return candidates_; }
   [[nodiscard]] size_t free_count() const { return free_count_; }
   [[nodiscard]] const InteractiveSpaceConfig& config() const { return config_; }
-  // Point i of W in the person's frame (x along their heading): (a cos phi_i, b sin phi_i).
+  // Design point i of W in the person's frame (x along their heading): (a cos phi_i,
+  // b sin phi_i); speed_standoff may move the candidate out from it.
   [[nodiscard]] Point2 point_in_person(size_t i) const {
     return {config_.a_m * cos_phi_[i], config_.b_m * sin_phi_[i]};
   }

@@ -110,6 +110,7 @@ struct DaemonConfig {
     double ellipse_a_m = 0;
     double ellipse_b_m = 0;
     double cost_threshold = 0;
+    bool speed_standoff = false;
   } interactive_space;
 
   struct Objective {
