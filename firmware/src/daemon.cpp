@@ -235,6 +235,7 @@ Daemon::Daemon(const DaemonConfig& cfg, hal::SystemdNotifier& notifier)
                 : cfg.policy.selector == "fixed_behind" ? Selector::kFixedBehind
                 : cfg.policy.selector == "fixed_side"   ? Selector::kFixedSide
                                                         : Selector::kAuto),
+      standoff_velocity_filter_(cfg.interactive_space.speed_standoff_filter_s),
       goal_hold_(core::from_ms(std::llround(cfg.policy.hold_last_point_ms))),
       mppi_(mppi_config(cfg)),
       pid_(pid_follower_config(cfg)),
@@ -461,6 +462,7 @@ void Daemon::policy_task(const core::Tick& tick) {
   }
   if (!track || !track->value.valid) {
     g.status = core::GoalStatus::kNoPerson;
+    standoff_velocity_filter_.reset();
   } else if (!map) {
     g.status = core::GoalStatus::kNoCostmap;
   } else {
@@ -468,7 +470,13 @@ void Daemon::policy_task(const core::Tick& tick) {
     const core::HumanState h =
         core::human_state(track->value, tick.now, robot_odom, human_config_,
                           th ? th->value.confidence : core::TrackerConfidence::kUnknown);
-    space_.update(h.pose_base, robot_odom, *map, h.velocity_base);
+    // The standoff's velocity, smoothed in odom (the robot's turning does not move it).
+    const double since_s = standoff_velocity_filter_.primed()
+                               ? core::to_seconds(tick.now - standoff_velocity_stamp_)
+                               : 0.0;
+    standoff_velocity_stamp_ = tick.now;
+    const core::Point2 velocity_odom = standoff_velocity_filter_.update(h.velocity_odom, since_s);
+    space_.update(h.pose_base, robot_odom, *map, robot_odom.inverse().rotate(velocity_odom));
     core::Selection s = core::select_by_objective(space_);
     if (selector_ == Selector::kFixedBehind || selector_ == Selector::kFixedSide) {
       // Evaluation baselines: one point of W, free or not (phi = pi behind, pi/2 the left side).

@@ -25,6 +25,7 @@
 #include "core/policy/observation.hpp"
 #include "core/safety/motion_gate.hpp"
 #include "core/safety/supervisor.hpp"
+#include "core/util/low_pass.hpp"
 #include "firmware/config/daemon_config.hpp"
 #include "firmware/lidar_pipeline.hpp"
 #include "firmware/logging.hpp"
@@ -271,6 +272,10 @@ class Daemon {
   Selector selector_ = Selector::kAuto;  // policy.selector, resolved once
   std::unique_ptr<core::MlpPolicy> policy_;
   std::vector<float> observation_;
+  // The person's velocity for interactive_space.speed_standoff, smoothed (its noise would move
+  // q^d with it); reset while there is no person.
+  core::LowPass2 standoff_velocity_filter_;
+  core::Nanos standoff_velocity_stamp_{0};
   core::GoalHold goal_hold_;  // policy.hold_last_point_ms; its index is the previous action
   core::LatestValue<CompanionGoal> goal_;
 

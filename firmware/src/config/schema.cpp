@@ -664,6 +664,15 @@ std::vector<FieldSpec> build() {
        0,
        0,
        {}},
+      {"interactive_space.speed_standoff_filter_s",
+       "s",
+       "Time constant of the low-pass on the person's velocity that interactive_space."
+       "speed_standoff uses: the standoff grows ~0.7 m per m/s at walking pace, so the tracker's "
+       "velocity noise would move q^d by centimetres at every selection. 0: unfiltered.",
+       FIELD(interactive_space.speed_standoff_filter_s),
+       0.0,
+       5.0,
+       {}},
       {"policy.file",
        "path",
        "Learned selector (policy file, format in core/include/core/policy/mlp_policy.hpp). Empty: "

@@ -111,6 +111,7 @@ struct DaemonConfig {
     double ellipse_b_m = 0;
     double cost_threshold = 0;
     bool speed_standoff = false;
+    double speed_standoff_filter_s = 0;
   } interactive_space;
 
   struct Objective {
