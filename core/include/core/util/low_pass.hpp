@@ -1,8 +1,9 @@
 #pragma once
-// First-order low-pass of a 2-D value sampled at irregular times: y += (1 - exp(-dt / tau)) (x -
-// y), exact for a value held over dt, so the result does not depend on the sampling rate. The first
-// sample after construction or reset() passes through; tau <= 0 passes every sample through.
-// Time is passed in (dt), never read.
+// First-order low-pass of a 2-D value sampled at irregular times:
+//   y += (1 - exp(-dt / tau)) (x - y),
+// exact for a value held over dt, so the result does not depend on the sampling rate. The
+// first sample after construction or reset() passes through; tau <= 0 passes every sample
+// through. Time is passed in (dt), never read.
 #include <algorithm>
 #include <cmath>
 
@@ -26,7 +27,6 @@ class LowPass2 {
   }
   void reset() { primed_ = false; }
   [[nodiscard]] bool primed() const { return primed_; }
-  [[nodiscard]] const Point2& value() const { return y_; }
 
  private:
   double time_constant_s_;
