@@ -470,13 +470,14 @@ void Daemon::policy_task(const core::Tick& tick) {
     const core::HumanState h =
         core::human_state(track->value, tick.now, robot_odom, human_config_,
                           th ? th->value.confidence : core::TrackerConfidence::kUnknown);
-    // The standoff's velocity, smoothed in odom (the robot's turning does not move it).
-    const double since_s = standoff_velocity_filter_.primed()
-                               ? core::to_seconds(tick.now - standoff_velocity_stamp_)
-                               : 0.0;
-    standoff_velocity_stamp_ = tick.now;
-    const core::Point2 velocity_odom = standoff_velocity_filter_.update(h.velocity_odom, since_s);
-    space_.update(h.pose_base, robot_odom, *map, robot_odom.inverse().rotate(velocity_odom));
+    // The standoff's velocity, smoothed in odom (the robot's turning does not move it); only
+    // the standoff reads it.
+    const core::Point2 velocity_base =
+        space_.config().speed_standoff
+            ? robot_odom.inverse().rotate(
+                  standoff_velocity_filter_.update(h.velocity_odom, tick.now))
+            : h.velocity_base;
+    space_.update(h.pose_base, robot_odom, *map, velocity_base);
     core::Selection s = core::select_by_objective(space_);
     if (selector_ == Selector::kFixedBehind || selector_ == Selector::kFixedSide) {
       // Evaluation baselines: one point of W, free or not (phi = pi behind, pi/2 the left side).

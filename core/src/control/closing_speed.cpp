@@ -66,11 +66,9 @@ double follow_standoff_m(const Point2& toward_person, const Point2& person_veloc
   // convex, so its distance to the ray's points grows with the distance along it (bisection).
   const Footprint& f = c.footprint;
   auto box_distance_sq = [&](double d) {  // squared: no square root in the loop
-    const double x = d * ux;
-    const double y = d * uy;
-    const double dx = std::max({f.x_min_m - x, 0.0, x - f.x_max_m});
-    const double dy = std::max({f.y_min_m - y, 0.0, y - f.y_max_m});
-    return dx * dx + dy * dy;
+    const Point2 q{d * ux, d * uy};
+    const Point2 n = f.nearest(q);
+    return (q.x_m - n.x_m) * (q.x_m - n.x_m) + (q.y_m - n.y_m) * (q.y_m - n.y_m);
   };
   const double body_gap_sq = body_gap_m * body_gap_m;
   double lo = 0.0;
@@ -91,8 +89,7 @@ ClosingSpeedResult limit_closing_speed(const Point2& person_in_base,
   if (c.robot_decel_mps2 <= 0.0) return out;  // off
   const Footprint& f = c.footprint;
   // The footprint's point nearest the person, and the direction from it to them.
-  const Point2 near{std::clamp(person_in_base.x_m, f.x_min_m, f.x_max_m),
-                    std::clamp(person_in_base.y_m, f.y_min_m, f.y_max_m)};
+  const Point2 near = f.nearest(person_in_base);
   double nx = person_in_base.x_m - near.x_m;
   double ny = person_in_base.y_m - near.y_m;
   double dist = std::hypot(nx, ny);

@@ -37,11 +37,10 @@ void InteractiveSpace::update(const Pose2& person_base, const Pose2& robot_odom,
                               const Costmap& costmap, const Point2& person_velocity_base) {
   free_count_ = 0;
   // The person's velocity in their own frame: a robot at a point of W faces their heading, so
-  // its axes are theirs.
-  const double c_h = std::cos(person_base.theta_rad);
-  const double s_h = std::sin(person_base.theta_rad);
-  const Point2 velocity_person{c_h * person_velocity_base.x_m + s_h * person_velocity_base.y_m,
-                               -s_h * person_velocity_base.x_m + c_h * person_velocity_base.y_m};
+  // its axes are theirs (only the standoff reads it).
+  const Point2 velocity_person =
+      config_.speed_standoff ? Pose2{0.0, 0.0, -person_base.theta_rad}.rotate(person_velocity_base)
+                             : Point2{};
   for (size_t i = 0; i < candidates_.size(); ++i) {
     Candidate& c = candidates_[i];
     // G weighs the design point (the paper's W): the standoff below moves the diagonal points

@@ -275,7 +275,6 @@ class Daemon {
   // The person's velocity for interactive_space.speed_standoff, smoothed (its noise would move
   // q^d with it); reset while there is no person.
   core::LowPass2 standoff_velocity_filter_;
-  core::Nanos standoff_velocity_stamp_{0};
   core::GoalHold goal_hold_;  // policy.hold_last_point_ms; its index is the previous action
   core::LatestValue<CompanionGoal> goal_;
 

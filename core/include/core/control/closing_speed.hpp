@@ -20,6 +20,8 @@
 // velocity box, then scaled toward zero if the box pushed it back over. Why it exists: with q^d
 // on the ellipse's edge, a robot catching up at 1.5 m/s met the person's turn faster than its
 // 1.5 m/s^2 brakes could stop in the 0.2-0.4 m left between the bodies (docs/EVALUATION.md).
+#include <algorithm>
+
 #include "core/control/dcbf_repair.hpp"
 #include "core/geometry/pose2.hpp"
 
@@ -27,6 +29,10 @@ namespace core {
 
 struct Footprint {
   double x_min_m = -0.35, x_max_m = 0.35, y_min_m = -0.30, y_max_m = 0.30;  // base_link box
+  // The box's point nearest `p` (base_link; `p` itself when inside).
+  [[nodiscard]] Point2 nearest(const Point2& p) const {
+    return {std::clamp(p.x_m, x_min_m, x_max_m), std::clamp(p.y_m, y_min_m, y_max_m)};
+  }
 };
 
 struct ClosingSpeedConfig {
