@@ -59,8 +59,9 @@ TEST(CompanionEval, RunsCasesAndMethodsByNameAndWritesTablesCsvAndPlots) {
   EXPECT_EQ(lines(csv), 1U + 3U + 6U) << csv;
   EXPECT_NE(csv.find("crowd-5,fixed_side,2,crowd-5-2,"), std::string::npos) << csv;
   // The controller's counters per trial: MPPI ran at 100 Hz for most of the 8 s and its
-  // structured samples won some steps; the path sample is off by default; the PID follower
-  // has no QP repair and no samples.
+  // structured samples won some steps; the path sample is on, but nothing in the corridor lies
+  // on the way to q^d, so its trigger must not plan one; the PID follower has no QP repair and
+  // no samples.
   EXPECT_GT(csv_value(csv, "corridor,objective,1,", "control_steps"), 400.0) << csv;
   EXPECT_LE(csv_value(csv, "corridor,objective,1,", "control_steps"), 800.0) << csv;
   EXPECT_GT(csv_value(csv, "corridor,objective,1,", "guided_plans"), 0.0) << csv;
