@@ -94,6 +94,8 @@ TEST(FollowEnv, TakesItsNumbersFromTheDaemonConfiguration) {
   EXPECT_DOUBLE_EQ(c.max_vy_mps, 1.5);
   EXPECT_LT(c.a_min_m, c.space.a_m);
   EXPECT_GT(c.a_max_m, c.space.a_m);
+  EXPECT_TRUE(c.space.speed_standoff);
+  EXPECT_DOUBLE_EQ(c.standoff_velocity_filter_s, 0.25);
 }
 
 TEST(FollowEnv, TheObservationIsTheDaemonsLayoutAndTheMaskIsP) {
@@ -218,6 +220,47 @@ TEST(FollowEnv, WithTheDaemonsStandoffThePointBehindMovesOutWithTheWalkingSpeed)
     EXPECT_LT(with[episode].mean_m, without[episode].mean_m + 0.6) << "episode " << episode;
     EXPECT_LT(with[episode].worst_m, 2.5) << "episode " << episode;
   }
+}
+
+// RMS of the step-to-step change of the point behind's distance from the person (s^p of index
+// n/2 against s^h, both in base_link), with a noisy velocity estimate, over one open-world
+// episode.
+double standoff_jitter_m(double filter_s) {
+  FollowEnvConfig c = open_world();
+  c.velocity_noise_mps = 0.3;
+  c.standoff_velocity_filter_s = filter_s;
+  FollowEnv env(c, 9);
+  Buffers b(env);
+  env.reset(b.obs, b.mask());
+  constexpr size_t kN = 64;
+  constexpr size_t kPointBehind = 4 * kN + 3 * 32;  // s^p: x, y of point n/2
+  constexpr size_t kPerson = 7 * kN + 256 + 3;      // s^h: x, y
+  double sum2 = 0, previous = -1;
+  int n = 0;
+  for (int step = 0; step < 300; ++step) {
+    if (env.step(32, b.obs, b.mask()).truncated) break;
+    const double d =
+        b.mask()[32] ? std::hypot(static_cast<double>(b.obs[kPointBehind] - b.obs[kPerson]),
+                                  static_cast<double>(b.obs[kPointBehind + 1] - b.obs[kPerson + 1]))
+                     : -1.0;
+    if (step > 30 && d > 0 && previous > 0) {
+      sum2 += (d - previous) * (d - previous);
+      ++n;
+    }
+    previous = d;
+  }
+  EXPECT_GT(n, 200);
+  return std::sqrt(sum2 / std::max(n, 1));
+}
+
+TEST(FollowEnv, TheStandoffReadsTheVelocityLowPassedAsTheDaemonDoes) {
+  // With 0.3 m/s of velocity noise the standoff (~0.7 m per m/s) would move the point behind by
+  // centimetres at every step; the daemon's 0.25 s low-pass, applied here too, takes most of it
+  // out (same seed, same noise draws).
+  const double raw = standoff_jitter_m(0.0);
+  const double filtered = standoff_jitter_m(0.25);
+  EXPECT_GT(raw, 0.02);
+  EXPECT_LT(filtered, 0.5 * raw) << "raw " << raw << " filtered " << filtered;
 }
 
 TEST(FollowEnv, AContactEndsTheEpisodeWithTheCollisionReward) {
