@@ -133,6 +133,7 @@ core::InteractiveSpaceConfig interactive_space_config(const DaemonConfig& cfg) {
   c.gamma = cfg.objective.gamma;
   c.delta = cfg.objective.delta;
   c.speed_standoff = cfg.interactive_space.speed_standoff;
+  c.speed_standoff_max_m = cfg.interactive_space.speed_standoff_max_m;
   c.closing = closing_speed_config(cfg);
   return c;
 }

@@ -52,8 +52,11 @@ void InteractiveSpace::update(const Pose2& person_base, const Pose2& robot_odom,
     Point2 in_person = point_in_person(i);
     if (config_.speed_standoff) {
       const double d = std::hypot(in_person.x_m, in_person.y_m);
-      const double standoff =
+      double standoff =
           follow_standoff_m({-in_person.x_m, -in_person.y_m}, velocity_person, config_.closing);
+      if (config_.speed_standoff_max_m > 0.0) {
+        standoff = std::min(standoff, config_.speed_standoff_max_m);
+      }
       if (d > 1e-9 && standoff > d) {
         in_person = {in_person.x_m * standoff / d, in_person.y_m * standoff / d};
       }

@@ -673,6 +673,16 @@ std::vector<FieldSpec> build() {
        0.0,
        5.0,
        {}},
+      {"interactive_space.speed_standoff_max_m",
+       "m",
+       "The farthest interactive_space.speed_standoff moves a point from the person. Beyond it "
+       "the closing-speed limit holds the robot and its plan pulls toward q^d against the limit, "
+       "as with the fixed ellipse: uncapped, a 1.7 m/s walker's point behind is ~1.8 m back, "
+       "at the 2 m loss rule's edge (docs/EVALUATION.md, twentieth session). 0: no cap.",
+       FIELD(interactive_space.speed_standoff_max_m),
+       0.0,
+       5.0,
+       {}},
       {"policy.file",
        "path",
        "Learned selector (policy file, format in core/include/core/policy/mlp_policy.hpp). Empty: "

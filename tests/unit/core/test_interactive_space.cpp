@@ -291,4 +291,28 @@ TEST(InteractiveSpace, SpeedStandoffMovesOutOnlyThePointsTheRobotCannotHoldAtThe
   }
 }
 
+TEST(InteractiveSpace, SpeedStandoffStopsAtItsCap) {
+  // A person walking forward at 1.7 m/s: uncapped, the point straight behind moves out to the
+  // stopping gap (~1.8 m, beyond a = 1 m); a cap of 1.4 m holds it there; a cap below a moves
+  // nothing (the standoff only ever moves a point out).
+  const core::Pose2 person{2.0, 0.0, 0.0};
+  const core::Point2 walking_base{1.7, 0.0};
+  core::InteractiveSpaceConfig cfg;
+  cfg.closing.robot_decel_mps2 = 1.0;
+  cfg.speed_standoff = true;
+  auto behind_m = [&](double cap_m) {
+    core::InteractiveSpaceConfig c = cfg;
+    c.speed_standoff_max_m = cap_m;
+    core::InteractiveSpace w(c);
+    w.update(person, core::Pose2{}, room(std::nullopt), walking_base);
+    const core::Pose2& b = w.candidates()[32].base;
+    return std::hypot(b.x_m - person.x_m, b.y_m - person.y_m);
+  };
+  const double uncapped = behind_m(0.0);
+  EXPECT_GT(uncapped, 1.6);
+  EXPECT_NEAR(behind_m(1.4), 1.4, 1e-9);
+  EXPECT_NEAR(behind_m(0.5), cfg.a_m, 1e-9);
+  EXPECT_NEAR(behind_m(5.0), uncapped, 1e-12);
+}
+
 }  // namespace

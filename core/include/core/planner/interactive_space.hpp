@@ -37,6 +37,10 @@ struct InteractiveSpaceConfig {
   // held there anyway; q^d there makes e measure tracking, not the safety gap, and keeps the
   // controller from pulling against the limit. false: the paper's fixed ellipse.
   bool speed_standoff = false;
+  // The farthest the standoff moves a point from the person (m; 0: no cap). Beyond it the
+  // closing-speed limit holds the robot and the plan pulls toward q^d against it, as with the
+  // fixed ellipse: at 1.7 m/s the uncapped point is ~1.8 m back, at the 2 m loss rule's edge.
+  double speed_standoff_max_m = 0.0;
   ClosingSpeedConfig closing;
 };
 

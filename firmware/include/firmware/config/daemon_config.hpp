@@ -112,6 +112,7 @@ struct DaemonConfig {
     double cost_threshold = 0;
     bool speed_standoff = false;
     double speed_standoff_filter_s = 0;
+    double speed_standoff_max_m = 0;
   } interactive_space;
 
   struct Objective {
