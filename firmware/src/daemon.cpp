@@ -134,6 +134,7 @@ core::InteractiveSpaceConfig interactive_space_config(const DaemonConfig& cfg) {
   c.delta = cfg.objective.delta;
   c.speed_standoff = cfg.interactive_space.speed_standoff;
   c.speed_standoff_max_m = cfg.interactive_space.speed_standoff_max_m;
+  c.speed_standoff_filter_s = cfg.interactive_space.speed_standoff_filter_s;
   c.closing = closing_speed_config(cfg);
   return c;
 }
@@ -236,7 +237,7 @@ Daemon::Daemon(const DaemonConfig& cfg, hal::SystemdNotifier& notifier)
                 : cfg.policy.selector == "fixed_behind" ? Selector::kFixedBehind
                 : cfg.policy.selector == "fixed_side"   ? Selector::kFixedSide
                                                         : Selector::kAuto),
-      standoff_velocity_filter_(cfg.interactive_space.speed_standoff_filter_s),
+      standoff_velocity_(space_.config()),
       goal_hold_(core::from_ms(std::llround(cfg.policy.hold_last_point_ms))),
       mppi_(mppi_config(cfg)),
       pid_(pid_follower_config(cfg)),
@@ -463,7 +464,7 @@ void Daemon::policy_task(const core::Tick& tick) {
   }
   if (!track || !track->value.valid) {
     g.status = core::GoalStatus::kNoPerson;
-    standoff_velocity_filter_.reset();
+    standoff_velocity_.reset();
   } else if (!map) {
     g.status = core::GoalStatus::kNoCostmap;
   } else {
@@ -471,13 +472,8 @@ void Daemon::policy_task(const core::Tick& tick) {
     const core::HumanState h =
         core::human_state(track->value, tick.now, robot_odom, human_config_,
                           th ? th->value.confidence : core::TrackerConfidence::kUnknown);
-    // The standoff's velocity, smoothed in odom (the robot's turning does not move it); only
-    // the standoff reads it.
     const core::Point2 velocity_base =
-        space_.config().speed_standoff
-            ? robot_odom.inverse().rotate(
-                  standoff_velocity_filter_.update(h.velocity_odom, tick.now))
-            : h.velocity_base;
+        standoff_velocity_.base(h.velocity_odom, h.velocity_base, robot_odom, tick.now);
     space_.update(h.pose_base, robot_odom, *map, velocity_base);
     core::Selection s = core::select_by_objective(space_);
     if (selector_ == Selector::kFixedBehind || selector_ == Selector::kFixedSide) {

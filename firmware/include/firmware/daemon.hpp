@@ -21,11 +21,11 @@
 #include "core/perception/costmap.hpp"
 #include "core/planner/goal_hold.hpp"
 #include "core/planner/interactive_space.hpp"
+#include "core/planner/standoff_velocity.hpp"
 #include "core/policy/mlp_policy.hpp"
 #include "core/policy/observation.hpp"
 #include "core/safety/motion_gate.hpp"
 #include "core/safety/supervisor.hpp"
-#include "core/util/low_pass.hpp"
 #include "firmware/config/daemon_config.hpp"
 #include "firmware/lidar_pipeline.hpp"
 #include "firmware/logging.hpp"
@@ -274,9 +274,8 @@ class Daemon {  // NOLINT(clang-analyzer-optin.performance.Padding)
   Selector selector_ = Selector::kAuto;  // policy.selector, resolved once
   std::unique_ptr<core::MlpPolicy> policy_;
   std::vector<float> observation_;
-  // The person's velocity for interactive_space.speed_standoff, smoothed (its noise would move
-  // q^d with it); reset while there is no person.
-  core::LowPass2 standoff_velocity_filter_;
+  // The person's velocity for interactive_space.speed_standoff; reset while there is no person.
+  core::StandoffVelocity standoff_velocity_;
   core::GoalHold goal_hold_;  // policy.hold_last_point_ms; its index is the previous action
   core::LatestValue<CompanionGoal> goal_;
 

@@ -55,7 +55,6 @@ Rewards step_rewards(const RewardConfig& c, double previous_distance_m, double d
 FollowEnvConfig follow_env_config(const firmware::DaemonConfig& daemon) {
   FollowEnvConfig c;
   c.space = firmware::interactive_space_config(daemon);
-  c.standoff_velocity_filter_s = daemon.interactive_space.speed_standoff_filter_s;
   // The sizes the paper randomises over, round the configured ellipse (+-20 %, +-25 %).
   c.a_min_m = 0.8 * c.space.a_m;
   c.a_max_m = 1.2 * c.space.a_m;
@@ -78,7 +77,7 @@ FollowEnv::FollowEnv(const FollowEnvConfig& config, uint64_t seed)
     : config_(config),
       rng_(seed),
       space_(config.space),
-      standoff_velocity_filter_(config.standoff_velocity_filter_s),
+      standoff_velocity_(config.space),
       grid_(config.grid) {
   rays_.reserve(static_cast<size_t>(config_.lidar_beams));
 }
@@ -110,7 +109,7 @@ void FollowEnv::new_world() {
   grid_ = core::VoxelGrid(config_.grid);
 
   t_s_ = 0;
-  standoff_velocity_filter_.reset();
+  standoff_velocity_.reset();
   person_ = scenario_.person.pose_at(0);
   person_v_ = scenario_.person.velocity_at(0);
   person_w_ = 0;
@@ -194,13 +193,9 @@ void FollowEnv::observe(std::span<float> observation, std::span<bool> mask) {
   human_.velocity_odom = {person_v_.x_m + vel(rng_), person_v_.y_m + vel(rng_)};
   human_.velocity_base = core::Pose2{0, 0, robot_.theta_rad}.inverse().apply(human_.velocity_odom);
   human_.yaw_rate_radps = person_w_;
-  // As the daemon does: the standoff reads the person's velocity low-passed in odom (the
-  // robot's turning does not move it); nothing else reads it.
-  const core::Point2 standoff_velocity_base =
-      space_.config().speed_standoff ? robot_.inverse().rotate(standoff_velocity_filter_.update(
-                                           human_.velocity_odom, nanos(t_s_)))
-                                     : human_.velocity_base;
-  space_.update(human_.pose_base, robot_, costmap_, standoff_velocity_base);
+  space_.update(
+      human_.pose_base, robot_, costmap_,
+      standoff_velocity_.base(human_.velocity_odom, human_.velocity_base, robot_, nanos(t_s_)));
 
   core::ObservationInputs in;
   in.space = &space_;

@@ -95,7 +95,7 @@ TEST(FollowEnv, TakesItsNumbersFromTheDaemonConfiguration) {
   EXPECT_LT(c.a_min_m, c.space.a_m);
   EXPECT_GT(c.a_max_m, c.space.a_m);
   EXPECT_TRUE(c.space.speed_standoff);
-  EXPECT_DOUBLE_EQ(c.standoff_velocity_filter_s, 0.25);
+  EXPECT_DOUBLE_EQ(c.space.speed_standoff_filter_s, 0.25);
 }
 
 TEST(FollowEnv, TheObservationIsTheDaemonsLayoutAndTheMaskIsP) {
@@ -228,7 +228,7 @@ TEST(FollowEnv, WithTheDaemonsStandoffThePointBehindMovesOutWithTheWalkingSpeed)
 double standoff_jitter_m(double filter_s) {
   FollowEnvConfig c = open_world();
   c.velocity_noise_mps = 0.3;
-  c.standoff_velocity_filter_s = filter_s;
+  c.space.speed_standoff_filter_s = filter_s;
   FollowEnv env(c, 9);
   Buffers b(env);
   env.reset(b.obs, b.mask());

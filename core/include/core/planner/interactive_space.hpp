@@ -41,6 +41,9 @@ struct InteractiveSpaceConfig {
   // closing-speed limit holds the robot and the plan pulls toward q^d against it, as with the
   // fixed ellipse: at 1.7 m/s the uncapped point is ~1.8 m back, at the 2 m loss rule's edge.
   double speed_standoff_max_m = 0.0;
+  // The time constant of the low-pass on the person's velocity that the standoff reads
+  // (core/planner/standoff_velocity.hpp; 0: unfiltered).
+  double speed_standoff_filter_s = 0.0;
   ClosingSpeedConfig closing;
 };
 

@@ -34,7 +34,7 @@
 #include "core/perception/costmap.hpp"
 #include "core/perception/voxel_grid.hpp"
 #include "core/planner/interactive_space.hpp"
-#include "core/util/low_pass.hpp"
+#include "core/planner/standoff_velocity.hpp"
 #include "firmware/config/daemon_config.hpp"
 #include "sim/scenario.hpp"
 #include "sim/social_force.hpp"
@@ -80,9 +80,6 @@ struct FollowEnvConfig {
   double position_noise_m = 0.03;  // the person's estimate (tracker filter error)
   double heading_noise_rad = 0.05;
   double velocity_noise_mps = 0.05;
-  // The daemon's low-pass on the person's velocity for the speed standoff
-  // (interactive_space.speed_standoff_filter_s): the same candidates as on the robot.
-  double standoff_velocity_filter_s = 0.0;
   // The robot: the daemon's limits and the steering law's gain.
   double max_vx_mps = 1.8, max_vy_mps = 1.5;
   double max_yaw_rate_radps = 2.0;
@@ -158,7 +155,7 @@ class FollowEnv {
   Scenario scenario_;
   Crowd crowd_;
   core::InteractiveSpace space_;
-  core::LowPass2 standoff_velocity_filter_;
+  core::StandoffVelocity standoff_velocity_;  // as the daemon's policy task has it
   core::VoxelGrid grid_;
   core::Costmap costmap_;
   std::vector<core::Ray> rays_;
