@@ -126,23 +126,28 @@ def heading_bound(t, ref, wz_max, alpha_max, iterations=50000, tol=1e-6):
     return math.sqrt(np.mean((x[:n] - ref) ** 2)), x[:n]
 
 
-def reactive_heading(t, ref, wz_max, alpha_max):
+def reactive_heading(t, ref, wz_max, alpha_max, step_s=0.005):
     """RMS of theta - ref for a heading law that sees only the person's heading now.
 
-    Starting on the reference at rest, it turns toward the current reference as fast as it can
-    still stop on it (omega = sqrt(2 alpha_max |e|), at most wz_max), its rate changing at most
-    alpha_max: a causal, feasible trajectory, so what a controller that does not anticipate the
-    person's turn can reach (to set against the bound, which may turn before the person does).
+    Starting on the reference at rest, it turns toward the current reference (interpolated
+    between the samples, no delay) as fast as it can still stop on it (omega = sqrt(2 alpha_max
+    |e|), at most wz_max), its rate changing at most alpha_max, every step_s: a causal, feasible
+    trajectory, so what a controller that does not anticipate the person's turn can reach, to
+    set against the bound (which may turn before the person does). Not a proof that no causal
+    law does better; the minimum-time answer to each heading as it comes.
     """
     theta, omega = ref[0], 0.0
     err = [0.0]
+    now = t[0]
     for k in range(1, len(t)):
-        dt = t[k] - t[k - 1]
-        e = ref[k - 1] - theta
-        want = math.copysign(min(wz_max, math.sqrt(2 * alpha_max * abs(e))), e)
-        new_omega = omega + max(-alpha_max * dt, min(alpha_max * dt, want - omega))
-        theta += 0.5 * (omega + new_omega) * dt
-        omega = new_omega
+        while now < t[k] - 1e-9:
+            dt = min(step_s, t[k] - now)
+            e = float(np.interp(now, t, ref)) - theta
+            want = math.copysign(min(wz_max, math.sqrt(2 * alpha_max * abs(e))), e)
+            new_omega = omega + max(-alpha_max * dt, min(alpha_max * dt, want - omega))
+            theta += 0.5 * (omega + new_omega) * dt
+            omega = new_omega
+            now += dt
         err.append(ref[k] - theta)
     return math.sqrt(np.mean(np.array(err) ** 2))
 
