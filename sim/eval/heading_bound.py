@@ -196,8 +196,9 @@ def main():
             reactive = reactive_heading(t, pth, wz_max, alpha_max)
             share_th, near = turn_share(t, pth, eth, args.turn_window)
             share_y, _ = turn_share(t, pth, ey, args.turn_window)
-            print(f"{path} | {len(t)} | {robot:.3f} | {bound:.3f} | {reactive:.3f} | {100 * share_th:.0f} % | "
-                  f"{math.sqrt(np.mean(ey**2)):.3f} | {100 * share_y:.0f} % | {100 * near:.0f} %")
+            print(f"{path} | {len(t)} | {robot:.3f} | {bound:.3f} | {reactive:.3f} | "
+                  f"{100 * share_th:.0f} % | {math.sqrt(np.mean(ey**2)):.3f} | "
+                  f"{100 * share_y:.0f} % | {100 * near:.0f} %")
         except (OSError, ValueError, KeyError, RuntimeError) as e:
             print(f"{path}: {e}", file=sys.stderr)
             status = 1

@@ -108,7 +108,8 @@ class HeadingBound(unittest.TestCase):
         with tempfile.TemporaryDirectory() as d:
             cfg = os.path.join(d, "limits.yaml")
             with open(cfg, "w") as f:
-                f.write(f"limits:\n  wz_max_radps: {WZ_MAX}\n  angular_accel_max_radps2: {ALPHA_MAX}\n")
+                f.write(f"limits:\n  wz_max_radps: {WZ_MAX}\n"
+                        f"  angular_accel_max_radps2: {ALPHA_MAX}\n")
             n = 101
             ref = step_reference(n)
             robot = bang_bang(n, math.pi / 2)
