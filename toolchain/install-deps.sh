@@ -13,7 +13,8 @@ packages=(
   libpcap-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   clang clang-format clang-tidy
-  systemd can-utils util-linux python3 python3-matplotlib python3-numpy python3-yaml tcpdump
+  systemd can-utils util-linux python3 python3-matplotlib python3-numpy python3-cvxopt python3-yaml
+  tcpdump
 )
 if [[ "${1:-}" == "--training" ]]; then
   packages+=(libtorch-dev libopenblas0-serial)

@@ -14,7 +14,7 @@ the daemon's configuration, the simulated base's too), its initial heading and t
 constraints are only the ones every such base satisfies between two samples (the rate at the
 samples, and the change of rate and of heading over a step that the acceleration limit allows),
 so the relaxed problem's optimum is below every real trajectory's: a lower bound, whatever the
-controller. Solved as a QP by ADMM (the OSQP iteration, numpy only: Debian's python3-numpy).
+controller. Solved as a sparse QP by cvxopt's interior-point solver (Debian's python3-cvxopt).
 
 Printed per file: the robot's e_theta RMSE on the same grid, the bound, a heading law that
 reacts to the person's heading without anticipating it (reactive_heading), and how much of the
@@ -22,41 +22,49 @@ robot's e_theta^2 and e_y^2 falls within S seconds (default 1) of the person tur
 than 0.5 rad/s.
 """
 import argparse
-import csv
 import math
 import os
 import sys
 
+import cvxopt  # Debian's python3-cvxopt: the QP
 import numpy as np
 
-
-def wrap(a):
-    return (a + math.pi) % (2 * math.pi) - math.pi
+import eval_samples
 
 
 def read_samples(path):
-    """(t, robot theta, person theta, e_x, e_y) over the tracked samples, headings unwrapped."""
-    t, rth, pth, ex, ey = [], [], [], [], []
-    with open(path, newline="") as f:
-        for row in csv.DictReader(f):
-            if row["active"] != "1" or row["has_goal"] != "1":
-                continue
-            rx, ry, rt = (float(row[k]) for k in ("robot_x_m", "robot_y_m", "robot_theta_rad"))
-            dx = float(row["goal_x_m"]) - rx
-            dy = float(row["goal_y_m"]) - ry
-            t.append(float(row["t_s"]))
-            rth.append(rt)
-            pth.append(float(row["person_theta_rad"]))
-            ex.append(math.cos(rt) * dx + math.sin(rt) * dy)
-            ey.append(-math.sin(rt) * dx + math.cos(rt) * dy)
-    if len(t) < 3:
+    """(t, robot theta, person theta, e_x, e_y, e_theta) over the tracked samples as arrays,
+    the headings unwrapped."""
+    s = eval_samples.tracking_errors(eval_samples.read_rows(path))
+    if len(s) < 3:
         raise ValueError(f"{path}: fewer than 3 tracked samples")
-    return (np.array(t), np.unwrap(np.array(rth)), np.unwrap(np.array(pth)), np.array(ex),
-            np.array(ey))
+    col = [np.array(c) for c in zip(*s)]
+    return col[0], np.unwrap(col[1]), np.unwrap(col[2]), col[3], col[4], col[5]
 
 
-def heading_bound(t, ref, wz_max, alpha_max, iterations=50000, tol=1e-6):
-    """Minimum RMS of theta - ref over headings a base within the limits can follow (ADMM).
+def limit_rows(dt, wz_max, alpha_max):
+    """The constraint rows of heading_bound as a sparse matrix's (rows, cols, values, row count)."""
+    n, m = len(dt) + 1, len(dt)
+    k = np.arange(m)
+    pos = 2.0 / (alpha_max * dt**2)
+    blocks = [  # (row within the block, column, value)
+        (np.arange(n), n + np.arange(n), np.full(n, 1.0 / wz_max)),  # rate
+        (np.r_[k, k], np.r_[n + k + 1, n + k],  # rate change
+         np.r_[1.0 / (alpha_max * dt), -1.0 / (alpha_max * dt)]),
+        (np.r_[k, k, k], np.r_[k + 1, k, n + k], np.r_[pos, -pos, -dt * pos]),  # heading change
+        (np.r_[k, k], np.r_[k + 1, k], np.r_[1.0 / (wz_max * dt), -1.0 / (wz_max * dt)]),  # turn
+    ]
+    rows, cols, vals, offset = [], [], [], 0
+    for r, c, v in blocks:
+        rows.append(r + offset)
+        cols.append(c)
+        vals.append(v)
+        offset += int(r.max()) + 1
+    return np.concatenate(rows), np.concatenate(cols), np.concatenate(vals), offset
+
+
+def heading_bound(t, ref, wz_max, alpha_max):
+    """Minimum RMS of theta - ref over headings a base within the limits can follow (a QP).
 
     Variables x = (theta_0..n-1, omega_0..n-1). Constraints l <= A x <= u, every row scaled to
     its limit so that all are of order one:
@@ -71,58 +79,21 @@ def heading_bound(t, ref, wz_max, alpha_max, iterations=50000, tol=1e-6):
     dt = np.diff(t)
     if np.any(dt <= 0):
         raise ValueError("sample times must increase")
-    rows = []
-    for k in range(n):
-        a = np.zeros(2 * n)
-        a[n + k] = 1.0 / wz_max
-        rows.append(a)
-    for k in range(n - 1):
-        a = np.zeros(2 * n)
-        a[n + k + 1] = 1.0 / (alpha_max * dt[k])
-        a[n + k] = -1.0 / (alpha_max * dt[k])
-        rows.append(a)
-        b = np.zeros(2 * n)
-        s = 1.0 / (alpha_max * dt[k] ** 2 / 2)
-        b[k + 1] = s
-        b[k] = -s
-        b[n + k] = -dt[k] * s
-        rows.append(b)
-        c = np.zeros(2 * n)
-        c[k + 1] = 1.0 / (wz_max * dt[k])
-        c[k] = -1.0 / (wz_max * dt[k])
-        rows.append(c)
-    A = np.array(rows)
-    lo, hi = -np.ones(A.shape[0]), np.ones(A.shape[0])
-    # Cost (theta - ref)^2 summed: P = 2 on the theta block, q = -2 ref; the time weights of the
-    # RMSE are the samples' (an even grid), so the plain sum.
-    P = np.zeros((2 * n, 2 * n))
-    P[:n, :n] = 2.0 * np.eye(n)
-    q = np.zeros(2 * n)
-    q[:n] = -2.0 * ref
-    rho, sigma, relax = 1.0, 1e-6, 1.6
-    K = P + sigma * np.eye(2 * n) + rho * A.T @ A
-    K_inv = np.linalg.inv(K)  # a few hundred samples: one dense inverse, then products
-
-    def solve(b):
-        return K_inv @ b
-
-    x = np.concatenate([ref, np.gradient(ref, t)])
-    z = np.clip(A @ x, lo, hi)
-    y = np.zeros(A.shape[0])
-    for _ in range(iterations):
-        x_t = solve(sigma * x - q + A.T @ (rho * z - y))
-        z_t = A @ x_t
-        x = relax * x_t + (1 - relax) * x
-        z_mix = relax * z_t + (1 - relax) * z
-        z_new = np.clip(z_mix + y / rho, lo, hi)
-        y = y + rho * (z_mix - z_new)
-        z = z_new
-        primal = np.max(np.abs(A @ x - z))
-        dual = np.max(np.abs(P @ x + q + A.T @ y))
-        if primal < tol and dual < tol * max(1.0, np.max(np.abs(q))):
-            break
-    else:
-        raise RuntimeError(f"ADMM did not converge (primal {primal:.2e}, dual {dual:.2e})")
+    rows, cols, vals, count = limit_rows(dt, wz_max, alpha_max)
+    # -1 <= A x <= 1 as G x <= h: A's rows, then their negation.
+    G = cvxopt.spmatrix(np.r_[vals, -vals].tolist(), np.r_[rows, rows + count].tolist(),
+                        np.r_[cols, cols].tolist(), (2 * count, 2 * n))
+    h = cvxopt.matrix(np.ones(2 * count))
+    # Cost sum (theta - ref)^2 = x' P x / 2 + q' x + const: P = 2 on the theta block, q = -2 ref;
+    # the time weights of the RMSE are the samples' (an even grid), so the plain sum.
+    P = cvxopt.spmatrix(2.0, range(n), range(n), (2 * n, 2 * n))
+    q = cvxopt.matrix(np.r_[-2.0 * ref, np.zeros(n)])
+    options = {"show_progress": False, "abstol": 1e-9, "reltol": 1e-9, "feastol": 1e-9,
+               "maxiters": 200}
+    result = cvxopt.solvers.qp(P, q, G, h, options=options)
+    if result["status"] != "optimal":
+        raise RuntimeError(f"QP not solved ({result['status']})")
+    x = np.array(result["x"]).ravel()
     return math.sqrt(np.mean((x[:n] - ref) ** 2)), x[:n]
 
 
@@ -189,8 +160,7 @@ def main():
     status = 0
     for path in args.samples:
         try:
-            t, rth, pth, ex, ey = read_samples(path)
-            eth = np.array([wrap(a) for a in pth - rth])
+            t, rth, pth, ex, ey, eth = read_samples(path)
             robot = math.sqrt(np.mean(eth**2))
             bound, _ = heading_bound(t, pth, wz_max, alpha_max)
             reactive = reactive_heading(t, pth, wz_max, alpha_max)

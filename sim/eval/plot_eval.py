@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Plots of a companion-eval output directory (Debian's python3-matplotlib, no other modules).
+"""Plots of a companion-eval output directory (Debian's python3-matplotlib; eval_samples.py).
 
     /usr/bin/python3 sim/eval/plot_eval.py OUT_DIR   (the system Python: Debian's matplotlib)
 
@@ -14,7 +14,6 @@ Writes into OUT_DIR/plots/:
                          or more cases of the group
 The trajectories and errors need the per-trial samples (companion-eval --samples).
 """
-import csv
 import math
 import os
 import sys
@@ -24,13 +23,10 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+import eval_samples  # noqa: E402
+
 SIDES = ["front", "front_left", "left", "behind_left", "behind", "behind_right", "right",
          "front_right"]
-
-
-def read_csv(path):
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
 
 
 def sides_plot(case, rows, out):
@@ -110,8 +106,9 @@ def first_samples(out_dir, case, rows):
     for r in rows:
         stem = os.path.join(out_dir, "samples", case, f"{r['method']}-{r['seed']}")
         if r["method"] not in picked and os.path.exists(stem + ".csv"):
-            world = read_csv(stem + "-world.csv") if os.path.exists(stem + "-world.csv") else []
-            picked[r["method"]] = (read_csv(stem + ".csv"), world)
+            world_path = stem + "-world.csv"
+            world = eval_samples.read_rows(world_path) if os.path.exists(world_path) else []
+            picked[r["method"]] = (eval_samples.read_rows(stem + ".csv"), world)
     return picked
 
 
@@ -154,19 +151,10 @@ def trajectories_plot(case, samples, out):
 def errors_plot(case, samples, out):
     fig, axes = plt.subplots(3, 1, figsize=(9, 6.5), sharex=True)
     for method, (s, _) in sorted(samples.items()):
-        t, ex, ey, et = [], [], [], []
-        for x in s:
-            if x["has_goal"] != "1" or x["active"] != "1":
-                continue
-            rx, ry, rth = float(x["robot_x_m"]), float(x["robot_y_m"]), float(x["robot_theta_rad"])
-            dx, dy = float(x["goal_x_m"]) - rx, float(x["goal_y_m"]) - ry
-            t.append(float(x["t_s"]))
-            ex.append(math.cos(rth) * dx + math.sin(rth) * dy)
-            ey.append(-math.sin(rth) * dx + math.cos(rth) * dy)
-            # q^d faces the person's heading; the samples carry the person's heading.
-            e = float(x["person_theta_rad"]) - rth
-            et.append(math.atan2(math.sin(e), math.cos(e)))
-        for ax, v in zip(axes, (ex, ey, et)):
+        tracked = eval_samples.tracking_errors(s)
+        t = [x.t_s for x in tracked]
+        for ax, v in zip(axes, ([x.ex_m for x in tracked], [x.ey_m for x in tracked],
+                                [x.etheta_rad for x in tracked])):
             ax.plot(t, v, label=method, linewidth=1)
     for ax, name in zip(axes, ("e_x [m]", "e_y [m]", "e_theta [rad]")):
         ax.set_ylabel(name)
@@ -185,7 +173,7 @@ def main():
         print(__doc__)
         return 2
     out_dir = sys.argv[1]
-    rows = read_csv(os.path.join(out_dir, "trials.csv"))
+    rows = eval_samples.read_rows(os.path.join(out_dir, "trials.csv"))
     plots = os.path.join(out_dir, "plots")
     os.makedirs(plots, exist_ok=True)
     written = []

@@ -1,0 +1,42 @@
+"""A trial's sample file (companion-eval --samples) read as tracking errors.
+
+Shared by plot_eval.py (errors over time) and heading_bound.py (the e_theta bound), so that both
+compute e = q^d - robot the same way as each other. Standard library only: importing it loads
+neither matplotlib nor numpy.
+"""
+import collections
+import csv
+import math
+
+TrackedSample = collections.namedtuple(
+    "TrackedSample", "t_s robot_theta_rad person_theta_rad ex_m ey_m etheta_rad")
+
+
+def wrap(angle_rad):
+    """The angle in [-pi, pi)."""
+    return (angle_rad + math.pi) % (2 * math.pi) - math.pi
+
+
+def read_rows(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def tracking_errors(rows):
+    """One TrackedSample per row where the robot is active and has a q^d.
+
+    e_x, e_y: q^d - robot in the robot's frame. e_theta: the person's heading - the robot's,
+    wrapped (q^d faces the person's way; the samples carry the person's heading, the true one,
+    where companion-eval's metric uses the chosen point's from the daemon's estimate).
+    """
+    out = []
+    for row in rows:
+        if row["active"] != "1" or row["has_goal"] != "1":
+            continue
+        rx, ry, rth = (float(row[k]) for k in ("robot_x_m", "robot_y_m", "robot_theta_rad"))
+        pth = float(row["person_theta_rad"])
+        dx, dy = float(row["goal_x_m"]) - rx, float(row["goal_y_m"]) - ry
+        out.append(TrackedSample(float(row["t_s"]), rth, pth,
+                                 math.cos(rth) * dx + math.sin(rth) * dy,
+                                 -math.sin(rth) * dx + math.cos(rth) * dy, wrap(pth - rth)))
+    return out
