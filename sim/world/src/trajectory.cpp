@@ -114,6 +114,13 @@ struct WalkPiece {
   }
 };
 
+// One end of a line: the speed there and how fast the walker changes to or from it (<= 0: at
+// once).
+struct SpeedRamp {
+  double v_mps = 0;
+  double accel_mps2 = 0;
+};
+
 class WalkBuilder {
  public:
   explicit WalkBuilder(core::Point2 start) : here_(start) {}
@@ -123,29 +130,42 @@ class WalkBuilder {
   void line_to(core::Point2 to, double speed_mps) {
     add_line(to, distance(here_, to) / std::max(speed_mps, 0.05));
   }
-  // A line from standing and/or to standing, speeding up and slowing down at accel_mps2 (on a
-  // leg too short for the full speed, to the speed it allows); accel_mps2 <= 0: at once, as
-  // line_to.
-  void line_to_eased(core::Point2 to, double speed_mps, bool from_rest, bool to_rest,
-                     double accel_mps2) {
+  // A line entered at `in.v_mps` and left at `out.v_mps`, at `speed_mps` between, each change
+  // of speed made evenly at its ramp's accel_mps2 (<= 0: at once, as line_to). On a leg too
+  // short for the full speed, the speed it allows; too short even to get from one end's speed
+  // to the other's within the ramps, one even change over the whole leg.
+  void line_to_eased(core::Point2 to, double speed_mps, SpeedRamp in, SpeedRamp out) {
     const double len = distance(here_, to);
-    const int ramps = (from_rest ? 1 : 0) + (to_rest ? 1 : 0);
-    if (accel_mps2 <= 0 || ramps == 0 || len < 1e-9) {
+    double v = std::max(speed_mps, 0.05);
+    // Ramp length per unit of v^2 - v_end^2: 1 / 2a, 0 when the change is at once.
+    const double k_in = in.accel_mps2 > 0 ? 0.5 / in.accel_mps2 : 0.0;
+    const double k_out = out.accel_mps2 > 0 ? 0.5 / out.accel_mps2 : 0.0;
+    auto ramp_m = [&](double k, double v_end) { return k * std::abs(v * v - v_end * v_end); };
+    if (len < 1e-9 || ramp_m(k_in, in.v_mps) + ramp_m(k_out, out.v_mps) < 1e-12) {
       line_to(to, speed_mps);
       return;
     }
-    // Each ramp takes v^2 / 2a of the leg.
-    const double v = std::min(std::max(speed_mps, 0.05), std::sqrt(2.0 * accel_mps2 * len / ramps));
-    const double ramp_m = v * v / (2.0 * accel_mps2);
+    if (ramp_m(k_in, in.v_mps) + ramp_m(k_out, out.v_mps) > len) {
+      // Up from in.v to v and down to out.v within the leg: v^2 (k_in + k_out) = len +
+      // k_in v_in^2 + k_out v_out^2.
+      v = std::sqrt((len + k_in * in.v_mps * in.v_mps + k_out * out.v_mps * out.v_mps) /
+                    (k_in + k_out));
+      // Not even room to get from one end's speed to the other's at the ramps' rates.
+      if (v < std::max(in.v_mps, out.v_mps)) {
+        add_eased(to, in.v_mps, out.v_mps, 2.0 * len / std::max(in.v_mps + out.v_mps, 0.05));
+        return;
+      }
+    }
+    const double in_m = ramp_m(k_in, in.v_mps);
+    const double out_m = ramp_m(k_out, out.v_mps);
     const core::Point2 dir{(to.x_m - here_.x_m) / len, (to.y_m - here_.y_m) / len};
+    const core::Point2 start = here_;
     auto along = [&](double d) {
-      return core::Point2{here_.x_m + d * dir.x_m, here_.y_m + d * dir.y_m};
+      return core::Point2{start.x_m + d * dir.x_m, start.y_m + d * dir.y_m};
     };
-    const core::Point2 cruise_from = from_rest ? along(ramp_m) : here_;
-    const core::Point2 cruise_to = to_rest ? along(len - ramp_m) : to;
-    if (from_rest) add_eased(cruise_from, 0.0, v, v / accel_mps2);
-    if (distance(here_, cruise_to) > 1e-9) line_to(cruise_to, v);
-    if (to_rest) add_eased(to, v, 0.0, v / accel_mps2);
+    if (in_m > 0) add_eased(along(in_m), in.v_mps, v, std::abs(v - in.v_mps) / in.accel_mps2);
+    if (len - in_m - out_m > 1e-9) line_to(along(len - out_m), v);
+    if (out_m > 0) add_eased(to, v, out.v_mps, std::abs(v - out.v_mps) / out.accel_mps2);
   }
   // The arc from here (on the incoming leg, heading `in_dir`) turning by `turn_rad`.
   void arc(core::Point2 in_dir, double turn_rad, double radius_m, double speed_mps) {
@@ -201,7 +221,9 @@ Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s, double s
   WalkBuilder b(waypoints.front().p);
   b.stand(start_s);
   b.stand(waypoints.front().pause_s);
-  bool from_rest = true;  // the leg about to be walked starts from standing
+  // How the leg about to be walked starts: from standing, or from a corner walked slower than
+  // its legs (at the corner's rate), or at its own speed.
+  SpeedRamp entry{0.0, corner.start_stop_accel_mps2};
   for (size_t i = 1; i < waypoints.size(); ++i) {
     const Waypoint& w = waypoints[i];
     const core::Point2 a = waypoints[i - 1].p;
@@ -210,9 +232,11 @@ Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s, double s
     const double len_out = last ? 0.0 : distance(w.p, waypoints[i + 1].p);
     if (!round_corners || last || w.pause_s > 0 || len_in < 1e-6 || len_out < 1e-6) {
       const bool to_rest = last || w.pause_s > 0;
-      b.line_to_eased(w.p, w.speed_mps, from_rest, to_rest, corner.start_stop_accel_mps2);
+      const SpeedRamp exit =
+          to_rest ? SpeedRamp{0.0, corner.start_stop_accel_mps2} : SpeedRamp{w.speed_mps, 0.0};
+      b.line_to_eased(w.p, w.speed_mps, entry, exit);
       b.stand(w.pause_s);
-      from_rest = to_rest;
+      entry = exit;
       continue;
     }
     const core::Point2 in{(w.p.x_m - a.x_m) / len_in, (w.p.y_m - a.y_m) / len_in};
@@ -221,8 +245,8 @@ Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s, double s
     const double turn = std::atan2(in.x_m * out_dir.y_m - in.y_m * out_dir.x_m,
                                    in.x_m * out_dir.x_m + in.y_m * out_dir.y_m);
     if (std::abs(turn) < 1e-3) {
-      b.line_to_eased(w.p, w.speed_mps, from_rest, false, corner.start_stop_accel_mps2);
-      from_rest = false;
+      b.line_to_eased(w.p, w.speed_mps, entry, {w.speed_mps, 0.0});
+      entry = {w.speed_mps, 0.0};
       continue;
     }
     // The tightest arc at walking speed v: r = max(v^2 / a_lat, v / omega). Its tangent points
@@ -238,9 +262,11 @@ Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s, double s
     }
     const double cut = r * half_tan;
     const core::Point2 arc_start{w.p.x_m - cut * in.x_m, w.p.y_m - cut * in.y_m};
-    b.line_to_eased(arc_start, w.speed_mps, from_rest, false, corner.start_stop_accel_mps2);
+    // Slowing into an arc walked slower than the leg (and speeding up out of it) at the
+    // corner's rate: a person does not stop from walking speed in one step.
+    b.line_to_eased(arc_start, w.speed_mps, entry, {v, corner.speed_change_accel_mps2});
     b.arc(in, turn, r, v);
-    from_rest = false;
+    entry = {v, corner.speed_change_accel_mps2};
   }
   const double t = b.end_s();
   const auto& pieces = b.pieces();

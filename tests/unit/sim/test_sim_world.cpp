@@ -135,6 +135,50 @@ TEST(Walk, ATurnBackOnShortLegsIsWalkedSlowerNotFaster) {
   EXPECT_GE(t.end_s(), back / limits.turn_rate_radps) << "at least the time to turn round";
 }
 
+// The largest acceleration (m/s^2, both axes) between from_s and to_s of a walk's samples.
+double peak_accel(const sim::Trajectory& t, double from_s, double to_s) {
+  double peak = 0;
+  const auto& s = t.samples();
+  auto velocity = [&](size_t i) {  // over the interval ending at sample i
+    const double dt = s[i].t_s - s[i - 1].t_s;
+    return core::Point2{(s[i].pose.x_m - s[i - 1].pose.x_m) / dt,
+                        (s[i].pose.y_m - s[i - 1].pose.y_m) / dt};
+  };
+  for (size_t i = 2; i < s.size(); ++i) {
+    if (s[i].t_s < from_s || s[i].t_s > to_s) continue;
+    const core::Point2 v1 = velocity(i);
+    const core::Point2 v0 = velocity(i - 1);
+    const double dt = 0.5 * (s[i].t_s - s[i - 2].t_s);
+    peak = std::max(peak, std::hypot(v1.x_m - v0.x_m, v1.y_m - v0.y_m) / dt);
+  }
+  return peak;
+}
+
+TEST(Walk, SlowsIntoATurnBackAndSpeedsUpOutOfItAtTheCornersRate) {
+  // 1.4 m/s out 6 m and back along nearly the same line: the arc that fits the legs is 2 cm
+  // across and walked at a crawl (a turn on the spot, ~1 s at 3 rad/s). The walker slows into it
+  // and speeds up out of it at 3 m/s^2, not in one step (and then walks back at the robot behind
+  // them at 10+ m/s^2: seeds 20 and 60 of the random benchmark, twenty-second session).
+  const std::vector<sim::Waypoint> out_and_back{{{0, 0}}, {{6, 0}, 1.4}, {{0, 0.1}, 1.4}};
+  const sim::CornerLimits limits;
+  ASSERT_GT(limits.speed_change_accel_mps2, 0.0);
+  const auto t = sim::walk(out_and_back, 0.0, 0.01, limits);
+  // Away from the start and end (from and to standing at once, as every benchmark walk).
+  const double inside_from = 0.2;
+  const double inside_to = t.end_s() - 0.2;
+  EXPECT_LE(peak_accel(t, inside_from, inside_to), limits.speed_change_accel_mps2 * 1.05);
+  // It still walks the whole way back, at its speed.
+  EXPECT_NEAR(t.pose_at(t.end_s()).x_m, 0.0, 1e-6);
+  EXPECT_NEAR(t.pose_at(t.end_s()).y_m, 0.1, 1e-6);
+  EXPECT_NEAR(t.velocity_at(t.end_s() - 1.0).x_m, -1.4, 1e-3);
+  // As before (0: at once), the same walk stops and turns back in a step.
+  sim::CornerLimits sudden_speed = limits;
+  sudden_speed.speed_change_accel_mps2 = 0.0;
+  const auto old = sim::walk(out_and_back, 0.0, 0.01, sudden_speed);
+  EXPECT_GT(peak_accel(old, inside_from, old.end_s() - 0.2), 10.0);
+  EXPECT_LT(old.end_s(), t.end_s());
+}
+
 TEST(Walk, APauseAtACornerTurnsOnTheSpot) {
   const auto t = sim::walk({{{0, 0}}, {{4, 0}, 1.0, 1.0}, {{4, 2}, 1.0}}, 0.0);
   EXPECT_NEAR(t.pose_at(4.5).x_m, 4.0, 1e-9) << "stands at the corner itself";

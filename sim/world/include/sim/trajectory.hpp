@@ -47,6 +47,12 @@ struct CornerLimits {
   // end) this evenly; 0: at once, as every walk of the benchmark worlds (changing it there
   // would change every trial). Turns taken on the spot while paused stay sudden.
   double start_stop_accel_mps2 = 0.0;
+  // A corner tighter than the walking speed allows (a turn back) is walked slower: the walker
+  // slows down into it and speeds up out of it this evenly (3 m/s^2: a brisk stop, the person's
+  // acceleration the daemon's closing-speed rule assumes). 0: at once, as the walks of the
+  // benchmark up to the twenty-first session (from 1.4 m/s to a near standstill in one 50 ms
+  // step, 10+ m/s^2, and back at the robot as fast: docs/EVALUATION.md, twenty-second session).
+  double speed_change_accel_mps2 = 3.0;
 };
 // Sampled every `step_s`, starting at `start_s` (standing at the first waypoint until then).
 Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s = 0.0, double step_s = 0.05,
