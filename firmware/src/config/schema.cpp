@@ -809,7 +809,8 @@ std::vector<FieldSpec> build() {
        {}},
       {"mppi.q_theta",
        "1/rad^2",
-       "c_theta: weight of the heading error in Q (paper: 20).",
+       "c_theta: weight of the heading error in Q (paper: 20; 60 turns the robot round with the "
+       "person at turn-backs: docs/EVALUATION.md).",
        FIELD(mppi.q_theta),
        0.0,
        1e6,
