@@ -21,6 +21,7 @@
 #include "sim/pedestrian_dataset.hpp"
 #include "sim/run_metrics.hpp"
 #include "sim/run_report.hpp"
+#include "sim/scenario.hpp"
 #include "sim/sim_run.hpp"
 #include "sim/sim_vlp16.hpp"
 #include "sim/sim_world.hpp"
@@ -208,10 +209,36 @@ TEST(Walk, StartsAndStopsAtTheGivenAccelerationWhenAsked) {
     const double v0 = (s[i - 1].pose.x_m - s[i - 2].pose.x_m) / (s[i - 1].t_s - s[i - 2].t_s);
     EXPECT_LE(std::abs(v1 - v0) / dt, 1.0 * 1.05 + 1e-6) << s[i].t_s;
   }
-  // Without it (every benchmark walk), the same walk starts and stops at once.
+  // Without it (0, the default), the same walk starts and stops at once.
   const auto sudden = sim::walk({{{0, 0}}, {{6, 0}, 1.2, 1.0}, {{0, 0}, 1.2}}, 0.0, 0.01);
   EXPECT_NEAR(sudden.velocity_at(0.1).x_m, 1.2, 1e-6);
   EXPECT_NEAR(sudden.end_s(), 2 * 5.0 + 1.0, 1e-6);
+}
+
+TEST(Walk, EveryBuiltInPersonStartsAndStopsAsBrisklyAsAPersonCan) {
+  // Scenarios 1-6, random walks (scenario 7) and dead ends: nowhere in the walk, its start and
+  // its stop included, faster than 3 m/s^2 (up to the twenty-third session they went from
+  // standing to walking speed in one 50 ms sample, 20 m/s^2, and stopped as suddenly).
+  std::vector<sim::Scenario> scenarios;
+  for (const char* name :
+       {"open", "static_obstacle", "pedestrian_front_right", "corridor", "doorway", "crossing"}) {
+    scenarios.push_back(*sim::make_scenario(name));
+  }
+  for (uint32_t seed = 1; seed <= 5; ++seed) {
+    scenarios.push_back(*sim::make_scenario("random", seed));
+    scenarios.push_back(*sim::make_scenario("dead_end", seed));
+  }
+  for (const sim::Scenario& s : scenarios) {
+    const sim::Trajectory& t = s.person;
+    EXPECT_LE(peak_accel(t, 0.0, t.end_s() + 1.0), 3.0 * 1.05) << s.name;
+    // Walking soon after the start, not a slow drift (the slowest built-in walk is 0.7 m/s).
+    const double start_s = 4.0;  // the built-in walks' start delay
+    EXPECT_LT(std::hypot(t.velocity_at(start_s - 0.05).x_m, t.velocity_at(start_s - 0.05).y_m),
+              1e-6)
+        << s.name;
+    EXPECT_GT(std::hypot(t.velocity_at(start_s + 0.8).x_m, t.velocity_at(start_s + 0.8).y_m), 0.65)
+        << s.name;
+  }
 }
 
 TEST(Walk, HeadingIsKeptWhileStanding) {

@@ -41,6 +41,9 @@ struct RandomScenarioOptions {
   double speed_min_mps = 0.7;
   double speed_max_mps = 1.5;
   double duration_s = 60.0;
+  // The person starts and stops this evenly (every built-in walk's 3 m/s^2); 0: at once, the
+  // walks up to the twenty-third session (a test can keep a situation found on one of them).
+  double start_stop_accel_mps2 = 3.0;
   // > 0: obstacles also beside the walk, every 2-4 m of it, on one side or both (a passage),
   // their surfaces this far from the person's path (to 0.3 m more): the constrained worlds.
   // Below ~1.45 m they close the points beside the person (b = 0.7 m, then the costmap's
