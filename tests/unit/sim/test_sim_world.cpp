@@ -218,7 +218,7 @@ TEST(Walk, StartsAndStopsAtTheGivenAccelerationWhenAsked) {
 TEST(Walk, EveryBuiltInPersonStartsAndStopsAsBrisklyAsAPersonCan) {
   // Scenarios 1-6, random walks (scenario 7) and dead ends: nowhere in the walk, its start and
   // its stop included, faster than 3 m/s^2 (up to the twenty-third session they went from
-  // standing to walking speed in one 50 ms sample, 20 m/s^2, and stopped as suddenly).
+  // standing to walking speed in one 50 ms sample, 14-30 m/s^2, and stopped as suddenly).
   std::vector<sim::Scenario> scenarios;
   for (const char* name :
        {"open", "static_obstacle", "pedestrian_front_right", "corridor", "doorway", "crossing"}) {
