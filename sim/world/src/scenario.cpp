@@ -12,16 +12,8 @@
 namespace sim {
 
 namespace {
-// Every built-in person starts walking here, after the daemon armed (costmap, tracker, base).
-constexpr double kStartDelayS = 4.0;
 constexpr double kTailS = 3.0;  // standing at the end, so the run ends at rest
-// Every built-in person speeds up from standing and slows down to standing this evenly (a brisk
-// start and stop, the acceleration the corners and the daemon's closing-speed rule assume), not
-// from 0 to walking speed in one 50 ms sample: a start no robot behind could follow without an
-// error, which up to the twenty-third session was most of e_y and e_theta in the straight walks
-// (docs/EVALUATION.md).
-constexpr double kStartStopAccelMps2 = 3.0;
-constexpr CornerLimits kBuiltInWalk{.start_stop_accel_mps2 = kStartStopAccelMps2};
+constexpr CornerLimits kBuiltInWalk{.start_stop_accel_mps2 = kBuiltInStartStopAccelMps2};
 
 Scenario base_scenario(const char* name, const char* description,
                        const std::vector<Waypoint>& walk_points,
@@ -29,7 +21,7 @@ Scenario base_scenario(const char* name, const char* description,
   Scenario s;
   s.name = name;
   s.description = description;
-  s.person = walk(walk_points, kStartDelayS, 0.05, corner);
+  s.person = walk(walk_points, kBuiltInStartDelayS, 0.05, corner);
   const core::Pose2 p0 = s.person.pose_at(0.0);
   s.robot_start = p0 * core::Pose2{-1.0, 0.0, 0.0};  // 1 m behind the person, same heading
   s.duration_s = s.person.end_s() + kTailS;
@@ -89,13 +81,25 @@ Scenario doorway() {
   return s;
 }
 
+// When a walk along +x first reaches `x_m` (s; interpolated between its samples).
+double time_reaching_x(const Trajectory& t, double x_m) {
+  const std::vector<TimedPose>& p = t.samples();
+  for (size_t i = 0; i < p.size(); ++i) {
+    if (p[i].pose.x_m < x_m) continue;
+    if (i == 0) return p[0].t_s;
+    const double f = (x_m - p[i - 1].pose.x_m) / (p[i].pose.x_m - p[i - 1].pose.x_m);
+    return p[i - 1].t_s + f * (p[i].t_s - p[i - 1].t_s);
+  }
+  return t.end_s();
+}
+
 Scenario crossing() {
   Scenario s = base_scenario("crossing", "three pedestrians crossing between robot and person",
                              {{{0, 0}}, {{16, 0}, 1.0}});
-  // Each crosses the walk 0.6 m behind the person (between the person and the robot); the person
-  // is v / (2 a) behind a walker who started at full speed.
+  // Each crosses the walk 0.6 m behind the person (between the person and the robot): at y = 0
+  // when the person is at x + 0.6.
   for (double x : {5.0, 8.0, 11.0}) {
-    const double t_cross = kStartDelayS + (x + 0.6) / 1.0 + 1.0 / (2 * kStartStopAccelMps2);
+    const double t_cross = time_reaching_x(s.person, x + 0.6);
     const double speed = 1.2;
     const double y0 = -speed * t_cross;
     s.pedestrians.push_back(walker({x, y0}, {x, 8.0}, speed));
@@ -219,7 +223,7 @@ Scenario random_scenario(uint32_t seed, const RandomScenarioOptions& o) {
   // The person's walk: legs of 4-8 m with turns up to +-100 degrees, inside a 24 m square.
   std::vector<Waypoint> pts{{{0, 0}}};
   double heading = 0;
-  double t = kStartDelayS;
+  double t = kBuiltInStartDelayS;
   core::Point2 p{0, 0};
   while (t < o.duration_s - kTailS) {
     for (int attempt = 0; attempt < 20; ++attempt) {
@@ -289,8 +293,8 @@ std::optional<Scenario> recorded_scenario(const PedestrianDataset& dataset, int 
     if (error != nullptr) *error = fmt::format("person {} is observed only once", follow_id);
     return std::nullopt;
   }
-  // Time shifted so the followed person appears at kStartDelayS (the daemon arms meanwhile).
-  const double shift = kStartDelayS - followed.start_s();
+  // Time shifted so the followed person appears at kBuiltInStartDelayS (the daemon arms meanwhile).
+  const double shift = kBuiltInStartDelayS - followed.start_s();
   auto shifted = [&](const Trajectory& tr) {
     std::vector<TimedPose> out = tr.samples();
     for (TimedPose& s : out)
@@ -307,7 +311,7 @@ std::optional<Scenario> recorded_scenario(const PedestrianDataset& dataset, int 
     if (id == follow_id) continue;
     const Trajectory moved = shifted(tr);
     // Only those who are around while the followed person walks.
-    if (moved.end_s() < kStartDelayS || moved.start_s() > s.person.end_s()) continue;
+    if (moved.end_s() < kBuiltInStartDelayS || moved.start_s() > s.person.end_s()) continue;
     s.replayed.push_back(moved);
   }
   s.duration_s = s.person.end_s() + kTailS;

@@ -230,14 +230,28 @@ TEST(Walk, EveryBuiltInPersonStartsAndStopsAsBrisklyAsAPersonCan) {
   }
   for (const sim::Scenario& s : scenarios) {
     const sim::Trajectory& t = s.person;
-    EXPECT_LE(peak_accel(t, 0.0, t.end_s() + 1.0), 3.0 * 1.05) << s.name;
+    EXPECT_LE(peak_accel(t, 0.0, t.end_s() + 1.0), sim::kBuiltInStartStopAccelMps2 * 1.05)
+        << s.name;
     // Walking soon after the start, not a slow drift (the slowest built-in walk is 0.7 m/s).
-    const double start_s = 4.0;  // the built-in walks' start delay
+    const double start_s = sim::kBuiltInStartDelayS;
     EXPECT_LT(std::hypot(t.velocity_at(start_s - 0.05).x_m, t.velocity_at(start_s - 0.05).y_m),
               1e-6)
         << s.name;
     EXPECT_GT(std::hypot(t.velocity_at(start_s + 0.8).x_m, t.velocity_at(start_s + 0.8).y_m), 0.65)
         << s.name;
+  }
+}
+
+TEST(Scenario, CrossingPedestriansAreTimedToPassJustBehindThePerson) {
+  // Scenario 6: each of the three walks across the person's path (y = 0) at their desired speed
+  // when the person is 0.6 m past them, i.e. between the person and the robot 1 m behind (the
+  // person's eased start puts them v / 2a behind one who started at full speed).
+  const sim::Scenario s = *sim::make_scenario("crossing");
+  ASSERT_EQ(s.pedestrians.size(), 3U);
+  for (const sim::Pedestrian& p : s.pedestrians) {
+    ASSERT_LT(p.position.y_m, 0.0);
+    const double t_cross_s = -p.position.y_m / p.desired_speed_mps;
+    EXPECT_NEAR(s.person.pose_at(t_cross_s).x_m, p.position.x_m + 0.6, 0.01) << p.position.x_m;
   }
 }
 

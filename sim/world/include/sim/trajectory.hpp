@@ -45,7 +45,7 @@ struct CornerLimits {
   double turn_rate_radps = 3.0;     // v / r: ~170 deg/s, a quick turn in one step
   // > 0: the walker speeds up from standing and slows down to standing (at a pause and at the
   // end) this evenly; 0: at once (the benchmark worlds' walks up to the twenty-third session;
-  // they ease at 3 m/s^2 since, dead ends at 1: sim/world/src/scenario.cpp). Turns taken on
+  // they ease at 3 m/s^2 since, dead ends at 1: sim/scenario.hpp). Turns taken on
   // the spot while paused stay sudden.
   double start_stop_accel_mps2 = 0.0;
   // A corner tighter than the walking speed allows (a turn back) is walked slower: the walker
@@ -59,9 +59,9 @@ struct CornerLimits {
 Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s = 0.0, double step_s = 0.05,
                 const CornerLimits& corner = {});
 
-// Headings of position samples from their motion (kept while standing: below 0.2 m/s).
 // Path length walked (m).
 double path_length(const Trajectory& t);
+// Headings of position samples from their motion (kept while standing: below 0.2 m/s).
 void set_headings_from_motion(std::vector<TimedPose>& samples);
 
 }  // namespace sim
