@@ -38,7 +38,7 @@ bench: deps
 	@cmake --preset release -DCOMPANION_BUILD_BENCH=ON > /dev/null
 	@cmake --build --preset release -j $(JOBS) --target bench_core bench_scheduler bench_tracker bench_lidar bench_control
 
-# The full evaluation of docs/EVALUATION.md (sim/eval/run_benchmark.sh; 2 h 20 min on 2 cores, twenty-third session; STEPS=... runs it in sittings).
+# The full evaluation of docs/EVALUATION.md (sim/eval/run_benchmark.sh; 2 h 15 min on 2 cores, twenty-fourth session; STEPS=... runs it in sittings).
 EVAL_OUT ?= eval-full
 eval: deps
 	@cmake --preset release > /dev/null

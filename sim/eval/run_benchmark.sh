@@ -5,7 +5,7 @@
 # it, and dead-end corridors) and both recorded-pedestrian files, for every method; then the plots
 # and one report (OUT/REPORT.md: every table, the wall time, trials per minute).
 #
-#   sim/eval/run_benchmark.sh [OUT]          (default: eval-full; ~2 h on 2 cores)
+#   sim/eval/run_benchmark.sh [OUT]          (default: eval-full; ~2 h 15 min on 2 cores)
 #
 # Environment: EVAL (the companion-eval binary, default build/release/sim/companion-eval),
 # TRIALS (random trials of scenario 7, default 50), VARIANT_TRIALS (per crowd/speed/size/clutter/dead-end case,
