@@ -132,6 +132,7 @@ core::InteractiveSpaceConfig interactive_space_config(const DaemonConfig& cfg) {
   c.beta = cfg.objective.beta;
   c.gamma = cfg.objective.gamma;
   c.delta = cfg.objective.delta;
+  c.switch_cost = cfg.objective.switch_cost;
   c.speed_standoff = cfg.interactive_space.speed_standoff;
   c.speed_standoff_max_m = cfg.interactive_space.speed_standoff_max_m;
   c.speed_standoff_filter_s = cfg.interactive_space.speed_standoff_filter_s;
@@ -475,7 +476,7 @@ void Daemon::policy_task(const core::Tick& tick) {
     const core::Point2 velocity_base =
         standoff_velocity_.base(h.velocity_odom, h.velocity_base, robot_odom, tick.now);
     space_.update(h.pose_base, robot_odom, *map, velocity_base);
-    core::Selection s = core::select_by_objective(space_);
+    core::Selection s = core::select_by_objective(space_, goal_hold_.index());
     if (selector_ == Selector::kFixedBehind || selector_ == Selector::kFixedSide) {
       // Evaluation baselines: one point of W, free or not (phi = pi behind, pi/2 the left side).
       const bool behind = selector_ == Selector::kFixedBehind;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <numbers>
 
@@ -74,14 +75,20 @@ void InteractiveSpace::update(const Pose2& person_base, const Pose2& robot_odom,
   }
 }
 
-Selection select_by_objective(const InteractiveSpace& space) {
+Selection select_by_objective(const InteractiveSpace& space, int previous_index) {
   Selection s;
   s.status = GoalStatus::kNoFreePoint;
   double best = std::numeric_limits<double>::infinity();
   const auto cs = space.candidates();
+  const int n = static_cast<int>(cs.size());
+  const double switch_cost =
+      previous_index >= 0 && previous_index < n ? space.config().switch_cost : 0.0;
   for (size_t i = 0; i < cs.size(); ++i) {
-    if (cs[i].free && cs[i].objective < best) {
-      best = cs[i].objective;
+    if (!cs[i].free) continue;
+    const int step = std::abs(static_cast<int>(i) - previous_index);
+    const double g = cs[i].objective + switch_cost * std::min(step, n - step);
+    if (g < best) {
+      best = g;
       s.index = static_cast<int>(i);
       s.goal_base = cs[i].base;
       s.status = GoalStatus::kOk;

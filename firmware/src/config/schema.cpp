@@ -755,6 +755,16 @@ std::vector<FieldSpec> build() {
        0.0,
        1000.0,
        {}},
+      {"objective.switch_cost",
+       "1/step",
+       "switch_cost: added to G per index step (wrapped) between a candidate and the point chosen "
+       "last; ours, the paper's action-smoothness reward r^a as a cost. 0: the paper's G. Above "
+       "0, q^d stays where it is on a near tie rather than jumping round the person (an "
+       "experiment: docs/EVALUATION.md, twenty-fifth session).",
+       FIELD(objective.switch_cost),
+       0.0,
+       1000.0,
+       {}},
       {"mppi.horizon_steps",
        "count",
        "K: prediction steps (paper: 100).",

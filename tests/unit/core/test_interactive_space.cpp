@@ -110,6 +110,42 @@ TEST(InteractiveSpace, DefaultWeightsSendALaggingRobotBehindThePersonNotBesideTh
   EXPECT_GT(aside_m, 0.0) << "on the robot's side of the person's track";
 }
 
+TEST(InteractiveSpace, SwitchCostKeepsThePointChosenLastOnANearTieButNotOnAClearPreference) {
+  // The robot at the right-hand point of a person walking along +x (the person 0.7 m to its
+  // left): with the default weights G prefers a point behind-right by 0.14 (the far points,
+  // alpha < 0), 13 steps round the ellipse; the last choice was the right-hand point (48 of 64).
+  core::InteractiveSpaceConfig cfg;
+  ASSERT_DOUBLE_EQ(cfg.switch_cost, 0.0) << "the paper's G by default";
+  const int right = 48;
+  const auto select = [&](double switch_cost, const core::Pose2& person, int previous) {
+    core::InteractiveSpaceConfig c = cfg;
+    c.switch_cost = switch_cost;
+    core::InteractiveSpace w(c);
+    w.update(person, core::Pose2{}, room(std::nullopt));
+    return core::select_by_objective(w, previous);
+  };
+  const core::Pose2 beside{0.0, 0.7, 0.0};
+  const core::Selection paper = select(0.0, beside, right);
+  ASSERT_EQ(paper.status, core::GoalStatus::kOk);
+  EXPECT_EQ(paper.index, 35) << "behind-right: G's own choice, the previous point ignored";
+  EXPECT_EQ(select(0.05, beside, right).index, right) << "0.05 a step: 0.65 for 13 steps";
+  EXPECT_EQ(select(0.05, beside, -1).index, 35) << "nothing chosen before: G alone";
+  // The robot 0.3 m behind that (G's preference 2.4): q^d still moves, most of the way.
+  const core::Selection lagging = select(0.05, core::Pose2{0.3, 0.7, 0.0}, right);
+  EXPECT_GE(lagging.index, 35);
+  EXPECT_LE(lagging.index, 38);
+  // A previous point that is no longer free is not kept: a wall 0.4 m right of the person.
+  core::InteractiveSpaceConfig c = cfg;
+  c.switch_cost = 0.05;
+  core::InteractiveSpace walled(c);
+  walled.update(core::Pose2{0.0, -0.4, 0.0}, core::Pose2{}, room(-1.0));
+  ASSERT_FALSE(walled.candidates()[right].free);
+  const core::Selection moved = core::select_by_objective(walled, right);
+  ASSERT_EQ(moved.status, core::GoalStatus::kOk);
+  EXPECT_NE(moved.index, right);
+  EXPECT_TRUE(walled.candidates()[static_cast<size_t>(moved.index)].free);
+}
+
 TEST(InteractiveSpace, DeltaDropsAPushedAsideLeaderBehindButKeepsOneThatIsAhead) {
   // The person at the origin walks along +x. The default delta = 4 per metre ahead; the paper's G
   // has none.

@@ -250,6 +250,7 @@ TEST(Config, ControllerParametersComeFromTheConfigurationAsInThePaper) {
   EXPECT_DOUBLE_EQ(w.beta, core_defaults.beta);
   EXPECT_DOUBLE_EQ(w.gamma, core_defaults.gamma);
   EXPECT_DOUBLE_EQ(w.delta, core_defaults.delta);
+  EXPECT_DOUBLE_EQ(w.switch_cost, core_defaults.switch_cost);
   EXPECT_DOUBLE_EQ(w.a_m, core_defaults.a_m);
   EXPECT_DOUBLE_EQ(w.b_m, core_defaults.b_m);
 }
@@ -287,6 +288,14 @@ TEST(Config, TheTrackingFrameIsAChoiceThatReachesTheController) {
   const auto r = load_config_text("mppi:\n  tracking_frame: robot\n", "test.yaml");
   ASSERT_TRUE(r.ok());
   EXPECT_EQ(firmware::mppi_config(*r.config).tracking_frame, core::TrackingFrame::kRobot);
+}
+
+TEST(Config, TheSwitchCostReachesTheSelectorAndMustNotBeNegative) {
+  const auto r = load_config_text("objective:\n  switch_cost: 0.05\n", "test.yaml");
+  ASSERT_TRUE(r.ok());
+  EXPECT_DOUBLE_EQ(firmware::interactive_space_config(*r.config).switch_cost, 0.05);
+  expect_error(load_config_text("objective:\n  switch_cost: -0.1\n", "test.yaml"), 2,
+               "objective.switch_cost", "out of range [0, 1000]");
 }
 
 TEST(Config, ANegativeAlphaIsAcceptedAndReachesTheSelector) {

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -241,8 +242,9 @@ struct DaemonWithBase {
   // `script` runs in the world task at every 5 ms step, before the daemon's tasks.
   // With `with_tracker`, a simulated Amfitrack streams the person's sensor too.
   explicit DaemonWithBase(std::function<void(Nanos, DaemonWithBase&)> script = {},
-                          bool with_tracker = false)
-      : daemon(defaults(), notifier), base_bus("daemon-base", clock), base(base_bus) {
+                          bool with_tracker = false,
+                          const firmware::DaemonConfig& config = defaults())
+      : daemon(config, notifier), base_bus("daemon-base", clock), base(base_bus) {
     auto host = std::make_unique<hal::VirtualCanBus>("daemon-base", clock);
     host_bus = host.get();
     EXPECT_TRUE(daemon.attach_base(std::move(host)));
@@ -563,6 +565,41 @@ TEST(DaemonWithTrackerAndLidar, ChoosesACompanionPointAroundThePerson) {
   EXPECT_LT(g->value.goal_base.x_m, 1.2);
   EXPECT_NE(d.daemon.status_line().find("| goal objective behind"), std::string::npos)
       << d.daemon.status_line();
+}
+
+TEST(DaemonWithTrackerAndLidar, TheSwitchCostCountsFromThePointChosenLast) {
+  // The person 1.2 m ahead and 0.3 m right, then (at 1 s) 0.3 m left: G's argmin moves to the
+  // mirror point. With objective.switch_cost the daemon passes the point it chose last to the
+  // selector, so a large cost keeps that point while it stays free.
+  const auto indices = [](double switch_cost) {
+    firmware::DaemonConfig config = defaults();
+    config.objective.switch_cost = switch_cost;
+    auto opened = hal::UdpReceiver::open({"127.0.0.1", 0}, 4 << 20, hal::UdpStamp::kDrain);
+    EXPECT_TRUE(opened.receiver) << opened.error;
+    RoundRoom room(opened.receiver->port());
+    std::array<int, 2> seen{-1, -1};
+    DaemonWithBase d(
+        [&](Nanos now, DaemonWithBase& w) {
+          if (now == 0ms) person_ahead(w.tracker);
+          if (now == 1000ms) w.tracker.set_sensor_pose(-1.2, -0.3, 0.0, std::numbers::pi);
+          room.step(now);
+          const auto g = w.daemon.goal().read();
+          const bool ok = g && g->value.status == core::GoalStatus::kOk;
+          if (now == 950ms && ok) seen[0] = g->value.index;
+          if (now == 1500ms && ok) seen[1] = g->value.index;
+        },
+        true, config);
+    d.daemon.attach_lidar(std::move(opened.receiver));
+    d.run_until(1500ms);
+    return seen;
+  };
+  const auto paper = indices(0.0);
+  ASSERT_GE(paper[0], 0) << "a goal before the person moves";
+  ASSERT_GE(paper[1], 0);
+  EXPECT_EQ(paper[1], 64 - paper[0]) << "G alone: the mirror point";
+  const auto kept = indices(1000.0);
+  EXPECT_EQ(kept[0], paper[0]) << "the first choice has no previous point to count from";
+  EXPECT_EQ(kept[1], kept[0]) << "kept: switching costs more than any difference in G";
 }
 
 TEST(Daemon, SideOfPersonNamesTheDesignPointsAngle) {

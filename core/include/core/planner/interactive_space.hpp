@@ -30,6 +30,10 @@ struct InteractiveSpaceConfig {
   double beta = 4.0;             // weight of the distance to the robot (= the shipped yaml)
   double gamma = 0.02;           // weight of the costmap cost
   double delta = 4.0;            // weight of how far the point is ahead of the person (ours)
+  // Ours: G of a point plus this much per index step (wrapped) from the point chosen last, the
+  // paper's action-smoothness reward r^a = -sigma_a |a_t - a_(t-1)| as a cost: on a near tie
+  // q^d stays where it is rather than jumping round the person. 0: the paper's G.
+  double switch_cost = 0.0;
   // Ours: when true, a point of W nearer the person than the robot may follow them under the
   // closing-speed limit (follow_standoff_m with `closing`, at the person's velocity) is moved
   // out along its ray to that distance: its cost, whether it is free, and q^d are taken there;
@@ -92,6 +96,7 @@ struct Selection {
 };
 
 // The objective selector: argmin G over P (ties: the lowest index, so it is deterministic).
-Selection select_by_objective(const InteractiveSpace& space);
+// `previous_index`: the point of W chosen last (-1: none), from which switch_cost counts.
+Selection select_by_objective(const InteractiveSpace& space, int previous_index = -1);
 
 }  // namespace core

@@ -120,6 +120,7 @@ struct DaemonConfig {
     double beta = 0;
     double gamma = 0;
     double delta = 0;
+    double switch_cost = 0;
   } objective;
 
   struct Policy {
