@@ -86,7 +86,10 @@ size_t FollowEnv::observation_size() const {
   return core::observation_size(static_cast<size_t>(config_.space.points));
 }
 
-void FollowEnv::new_world() {
+Scenario FollowEnv::draw_scenario() {
+  if (config_.dead_end_probability > 0 && uniform(rng_, 0, 1) < config_.dead_end_probability) {
+    return make_scenario("dead_end", static_cast<uint32_t>(rng_())).value();
+  }
   RandomScenarioOptions o;
   o.pedestrians = static_cast<int>(rng_() % static_cast<uint64_t>(config_.pedestrians_max + 1));
   o.obstacles = static_cast<int>(rng_() % static_cast<uint64_t>(config_.obstacles_max + 1));
@@ -97,7 +100,11 @@ void FollowEnv::new_world() {
     o.beside_walk_clearance_m =
         uniform(rng_, config_.beside_clearance_min_m, config_.beside_clearance_max_m);
   }
-  scenario_ = random_scenario(static_cast<uint32_t>(rng_()), o);
+  return random_scenario(static_cast<uint32_t>(rng_()), o);
+}
+
+void FollowEnv::new_world() {
+  scenario_ = draw_scenario();
   crowd_ = Crowd{};
   for (const Pedestrian& p : scenario_.pedestrians)
     crowd_.add(p);

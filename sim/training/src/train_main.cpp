@@ -136,6 +136,10 @@ int run(int argc, char** argv) {
   app.add_option("--tracking-distance", tracking_distance,
                  "D: r_tracking within this distance of the person (the paper's 0.75 m)")
       ->check(CLI::PositiveNumber);
+  double dead_end_fraction = 0;
+  app.add_option("--dead-end-fraction", dead_end_fraction,
+                 "episodes in the dead_end case's corridor instead of a random world (default 0)")
+      ->check(CLI::Range(0.0, 1.0));
   sim::training::PpoConfig ppo;
   app.add_option("--entropy", ppo.entropy_scale,
                  "entropy bonus (skrl's default 0; a deterministic policy then has KL 0 and "
@@ -161,6 +165,7 @@ int run(int argc, char** argv) {
   if (sigma_h >= 0) env_config.reward.sigma_h_per_m = sigma_h;
   if (sigma_a >= 0) env_config.reward.sigma_a_per_index = sigma_a;
   if (tracking_distance > 0) env_config.reward.tracking_distance_m = tracking_distance;
+  env_config.dead_end_probability = dead_end_fraction;
 
   if (dagger_rounds > 0 && imitate_rollouts <= 0) {
     fmt::print(stderr, "--dagger-rounds needs --imitate-rollouts (the rollouts of each round)\n");

@@ -27,6 +27,7 @@
 #include <cstdint>
 #include <random>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "core/control/dcbf_repair.hpp"
@@ -76,6 +77,10 @@ struct FollowEnvConfig {
   int obstacles_max = 10;
   double constrained_probability = 0.4;  // obstacles beside the walk
   double beside_clearance_min_m = 0.8, beside_clearance_max_m = 1.6;
+  // The dead_end case's corridor (the person turns back at its closed end) instead of a random
+  // world: the one constrained case the random worlds never make, where the point behind the
+  // person is past them. 0: none, and nothing drawn for it (earlier trainings' worlds unchanged).
+  double dead_end_probability = 0;
   double start_distance_min_m = 0.8, start_distance_max_m = 1.6;  // robot from the person
   double position_noise_m = 0.03;  // the person's estimate (tracker filter error)
   double heading_noise_rad = 0.05;
@@ -135,12 +140,15 @@ class FollowEnv {
   [[nodiscard]] int points() const { return config_.space.points; }
   [[nodiscard]] const EpisodeStats& last_episode() const { return last_episode_; }
   [[nodiscard]] uint64_t episodes() const { return episodes_; }
+  // The current episode's world, by scenario name ("random-S", "dead_end-S").
+  [[nodiscard]] const std::string& world_name() const { return scenario_.name; }
   // The objective selector's choice now (argmin G over P; -1 when P is empty): a baseline and
   // the fallback for a masked action.
   [[nodiscard]] int objective_action() const;
   [[nodiscard]] double robot_person_distance_m() const;
 
  private:
+  [[nodiscard]] Scenario draw_scenario();  // a random world, or the dead end
   void new_world();
   void scan();  // the ray fan into the voxel grid, then the costmap
   void observe(std::span<float> observation, std::span<bool> mask);
