@@ -46,6 +46,8 @@ core::SupervisorConfig supervisor_config(const DaemonConfig& cfg) {
   c.costmap_max_age = core::from_ms(s.costmap_max_age_ms);
   c.base_feedback_timeout = core::from_ms(s.base_feedback_timeout_ms);
   c.control_stall_timeout = core::from_ms(s.control_stall_timeout_ms);
+  c.control_overruns_to_hold = static_cast<uint32_t>(s.control_overruns_to_hold);
+  c.control_overrun_window = core::from_ms(s.control_overrun_window_ms);
   return c;
 }
 

@@ -173,9 +173,9 @@ TEST(CompanionSim, RealTimeRunAccompaniesThenSigtermStopsTheBaseAndWritesTheRepo
   for (int i = 0; i < 6; ++i) {
     ASSERT_TRUE(sock.receive_containing("STATUS=ACTIVE", 15s).has_value()) << p.output();
   }
-  // The status file is written once a second. A single control overrun on a busy shared machine
-  // holds the robot for resume_after_ms (as it must), so the file is read after each of the next
-  // STATUS=ACTIVE notifications until one snapshot shows ACTIVE (3 s of them at most).
+  // The status file is written once a second. Control overruns on a busy shared machine (three
+  // within a second) hold the robot for resume_after_ms (as they must), so the file is read after
+  // each of the next STATUS=ACTIVE notifications until one snapshot shows ACTIVE (3 s at most).
   std::string status = slurp(dir + "-status.json");
   for (int i = 0; i < 30 && status.find("\"state\":\"ACTIVE\"") == std::string::npos; ++i) {
     ASSERT_TRUE(sock.receive_containing("STATUS=ACTIVE", 15s).has_value()) << p.output();

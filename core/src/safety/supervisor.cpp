@@ -1,5 +1,6 @@
 #include "core/safety/supervisor.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -17,6 +18,10 @@ double age_ms(Nanos stamp, Nanos now) {
 }  // namespace
 
 Supervisor::Supervisor(const SupervisorConfig& config) : config_(config) {
+  // The ring holds at most kMaxControlOverrunsToHold; 0 would hold for ever (the loader rejects
+  // both: this is the last line of defence).
+  config_.control_overruns_to_hold =
+      std::clamp<uint32_t>(config_.control_overruns_to_hold, 1, kMaxControlOverrunsToHold);
   for (size_t i = 0; i < kReasonCount; ++i) {
     const Reason r = kReasonTable[i].reason;
     // Faults latch in the state machine; their debounce only needs to see the cause gone.
@@ -63,7 +68,11 @@ ReasonSet Supervisor::evaluate(const SafetyInputs& in, Nanos now) {
   if (counters_seen_) {
     if (config_.require_base)
       set(Reason::kCanWriteErrors, in.can_write_errors > last_write_errors_);
-    set(Reason::kControlOverrun, in.control_overruns > last_overruns_);
+    const uint64_t fresh = in.control_overruns > last_overruns_
+                               ? in.control_overruns - last_overruns_
+                               : 0;  // a counter that went backwards: nothing new
+    overruns_in_window_ = recent_overruns(fresh, now);
+    set(Reason::kControlOverrun, overruns_in_window_ >= config_.control_overruns_to_hold);
   }
   counters_seen_ = true;
   last_write_errors_ = in.can_write_errors;
@@ -79,6 +88,22 @@ ReasonSet Supervisor::evaluate(const SafetyInputs& in, Nanos now) {
     active[i] = debounce_[i].update(raw[i], now);
   }
   return active;
+}
+
+uint32_t Supervisor::recent_overruns(uint64_t new_overruns, Nanos now) {
+  const uint64_t record = std::min<uint64_t>(new_overruns, overrun_times_.size());
+  for (uint64_t i = 0; i < record; ++i) {
+    overrun_head_ = (overrun_head_ + 1) % overrun_times_.size();
+    overrun_times_[overrun_head_] = now;
+    overrun_count_ = std::min(overrun_count_ + 1, overrun_times_.size());
+  }
+  uint32_t in_window = 0;
+  for (size_t i = 0; i < overrun_count_; ++i) {
+    const size_t at = (overrun_head_ + overrun_times_.size() - i) % overrun_times_.size();
+    if (now - overrun_times_[at] >= config_.control_overrun_window) break;  // older ones too
+    ++in_window;
+  }
+  return in_window;
 }
 
 const char* confidence_name(TrackerConfidence c) {
@@ -142,7 +167,9 @@ void Supervisor::describe(const SafetyInputs& in, Nanos now, Reason r,
                           static_cast<unsigned long long>(in.can_write_errors));
       break;
     case Reason::kControlOverrun:
-      (void)std::snprintf(buf, n, "control overruns %llu",
+      (void)std::snprintf(buf, n, "control overruns %u in the last %.0f ms (limit %u; total %llu)",
+                          overruns_in_window_, to_ms(config_.control_overrun_window),
+                          config_.control_overruns_to_hold,
                           static_cast<unsigned long long>(in.control_overruns));
       break;
     case Reason::kControlStalled:

@@ -2,6 +2,8 @@
 
 #include <limits>
 
+#include "core/safety/supervisor.hpp"
+
 namespace firmware::config_schema {
 namespace {
 
@@ -561,6 +563,22 @@ std::vector<FieldSpec> build() {
        FIELD(supervisor.control_stall_timeout_ms),
        20,
        5000,
+       {}},
+      {"supervisor.control_overruns_to_hold",
+       "count",
+       "This many control runs ending after their deadline within control_overrun_window_ms is "
+       "'control overrun' (a HOLD). One late run leaves the base on the previous command a few ms "
+       "longer; 1 holds on every single one (a VM's scheduling stalls then stop the robot).",
+       FIELD(supervisor.control_overruns_to_hold),
+       1,
+       core::kMaxControlOverrunsToHold,
+       {}},
+      {"supervisor.control_overrun_window_ms",
+       "ms",
+       "The window in which control_overruns_to_hold overruns are counted.",
+       FIELD(supervisor.control_overrun_window_ms),
+       10,
+       60000,
        {}},
       {"supervisor.stop_linear_decel_mps2",
        "m/s^2",

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
 #include "core/safety/supervisor.hpp"
 
@@ -65,6 +66,7 @@ class Harness {
   Nanos now_ = 100s;
   int transitions_ = 0;
   core::Transition last_transition_{};
+  uint64_t overruns_ = 0;  // the scheduler's cumulative control overrun counter
 };
 
 std::string values(const core::Transition& t) {
@@ -226,22 +228,98 @@ TEST(Supervisor, FaultOutranksHold) {
   EXPECT_TRUE(out.active[core::reason_index(Reason::kTrackerSilent)]);
 }
 
-TEST(Supervisor, NewControlOverrunHoldsThenResumes) {
+// Overruns at the given offsets (from the harness's time when called) while every other input
+// is healthy; returns the last output. At each offset the scheduler's cumulative counter
+// (h.overruns_) grows by `per_tick`.
+core::SupervisorOutput overruns_at(Harness& h, const std::vector<Nanos>& offsets, Nanos duration,
+                                   uint64_t per_tick = 1) {
+  const Nanos start = h.now_;
+  size_t next = 0;
+  return h.run(duration, [&] {
+    auto in = h.healthy();
+    // h.now_ is the tick being evaluated (run() advances it before calling this).
+    while (next < offsets.size() && h.now_ - start >= offsets[next]) {
+      h.overruns_ += per_tick;
+      ++next;
+    }
+    in.control_overruns = h.overruns_;
+    return in;
+  });
+}
+
+TEST(Supervisor, ASingleControlOverrunIsCountedButDoesNotHold) {
+  Harness h;  // the default: 3 within 1 s
+  h.arm();
+  const auto out = overruns_at(h, {10ms}, 2s);
+  EXPECT_EQ(out.state, SafetyState::kActive);
+  EXPECT_EQ(h.transitions_, 0);
+}
+
+TEST(Supervisor, ControlOverrunsSpreadWiderThanTheWindowDoNotHold) {
   Harness h;
   h.arm();
-  uint64_t overruns = 0;
-  auto out = h.run(10ms, [&] {
-    auto in = h.healthy();
-    in.control_overruns = ++overruns;
-    return in;
-  });
-  EXPECT_EQ(out.reason, Reason::kControlOverrun);
-  out = h.run(1100ms, [&] {
-    auto in = h.healthy();
-    in.control_overruns = overruns;  // no new overrun
-    return in;
-  });
+  // Every 600 ms for 6 s: never three within one second (a VM's occasional stalls).
+  std::vector<Nanos> t;
+  for (Nanos at = 10ms; at < 6s; at += 600ms)
+    t.push_back(at);
+  const auto out = overruns_at(h, t, 6500ms);
   EXPECT_EQ(out.state, SafetyState::kActive);
+  EXPECT_EQ(h.transitions_, 0);
+}
+
+TEST(Supervisor, ControlOverrunsWithinTheWindowHoldWithTheCountThenResume) {
+  Harness h;
+  h.arm();
+  auto out = overruns_at(h, {10ms, 400ms, 900ms}, 890ms);
+  EXPECT_EQ(out.state, SafetyState::kActive) << "two in the window";
+  out = overruns_at(h, {10ms}, 10ms);  // the third, 890 ms after the first
+  EXPECT_EQ(out.state, SafetyState::kHold);
+  EXPECT_EQ(out.reason, Reason::kControlOverrun);
+  EXPECT_EQ(h.transitions_, 1);
+  EXPECT_EQ(values(h.last_transition_),
+            "control overruns 3 in the last 1000 ms (limit 3; total 3)");
+  // The condition lasts until the first of the three leaves the window (110 ms later), then
+  // resume_after (1 s) of clear.
+  out = h.run_healthy(1000ms);
+  EXPECT_EQ(out.state, SafetyState::kHold);
+  out = h.run_healthy(200ms);
+  EXPECT_EQ(out.state, SafetyState::kActive);
+}
+
+TEST(Supervisor, SeveralOverrunsBetweenTwoUpdatesCountEach) {
+  Harness h;
+  h.arm();
+  const auto out = overruns_at(h, {10ms}, 20ms, /*per_tick=*/3);
+  EXPECT_EQ(out.state, SafetyState::kHold);
+  EXPECT_EQ(out.reason, Reason::kControlOverrun);
+}
+
+TEST(Supervisor, ALimitOfOneHoldsOnEveryOverrun) {
+  SupervisorConfig cfg;
+  cfg.control_overruns_to_hold = 1;
+  Harness h(cfg);
+  h.arm();
+  auto out = overruns_at(h, {10ms}, 10ms);
+  EXPECT_EQ(out.state, SafetyState::kHold);
+  EXPECT_EQ(out.reason, Reason::kControlOverrun);
+  // The overrun counts for the window (1 s), then resume_after (1 s) of clear.
+  out = h.run_healthy(1900ms);
+  EXPECT_EQ(out.state, SafetyState::kHold);
+  out = h.run_healthy(200ms);
+  EXPECT_EQ(out.state, SafetyState::kActive);
+}
+
+TEST(Supervisor, AnOutOfRangeOverrunLimitIsClampedNotForever) {
+  SupervisorConfig cfg;
+  cfg.control_overruns_to_hold = 0;  // would hold for ever
+  Harness h(cfg);
+  h.arm();  // asserts ACTIVE: 0 became 1, which needs an overrun
+  EXPECT_EQ(overruns_at(h, {10ms}, 10ms).state, SafetyState::kHold);
+  cfg.control_overruns_to_hold = 100;  // more than the ring holds: would never hold
+  Harness g(cfg);
+  g.arm();
+  const auto out = overruns_at(g, {10ms}, 20ms, /*per_tick=*/core::kMaxControlOverrunsToHold);
+  EXPECT_EQ(out.state, SafetyState::kHold);
 }
 
 TEST(Supervisor, StalledControlFaultsAndStopsTheWatchdog) {

@@ -307,3 +307,22 @@ TEST(Config, ANegativeAlphaIsAcceptedAndReachesTheSelector) {
   expect_error(load_config_text("objective:\n  alpha: -1001.0\n", "test.yaml"), 2,
                "objective.alpha", "out of range [-1000, 1000]");
 }
+
+TEST(Config, TheControlOverrunRuleReachesTheSupervisorAndIsBounded) {
+  const auto r = load_config_text(
+      "supervisor:\n  control_overruns_to_hold: 5\n  control_overrun_window_ms: 2000\n",
+      "test.yaml");
+  ASSERT_TRUE(r.ok()) << r.errors[0].to_string();
+  const core::SupervisorConfig s = firmware::supervisor_config(*r.config);
+  EXPECT_EQ(s.control_overruns_to_hold, 5U);
+  EXPECT_EQ(s.control_overrun_window, std::chrono::milliseconds(2000));
+  const core::SupervisorConfig d =
+      firmware::supervisor_config(*firmware::load_default_config().config);
+  EXPECT_EQ(d.control_overruns_to_hold, 3U);
+  EXPECT_EQ(d.control_overrun_window, std::chrono::milliseconds(1000));
+  // 0 would hold for ever; more than the supervisor's ring holds would never hold.
+  expect_error(load_config_text("supervisor:\n  control_overruns_to_hold: 0\n", "test.yaml"), 2,
+               "supervisor.control_overruns_to_hold", "out of range [1, 16]");
+  expect_error(load_config_text("supervisor:\n  control_overruns_to_hold: 17\n", "test.yaml"), 2,
+               "supervisor.control_overruns_to_hold", "out of range [1, 16]");
+}

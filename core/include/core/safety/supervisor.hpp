@@ -61,12 +61,21 @@ struct SupervisorConfig {
   Nanos costmap_max_age = std::chrono::milliseconds(500);
   Nanos base_feedback_timeout = std::chrono::milliseconds(200);
   Nanos control_stall_timeout = std::chrono::milliseconds(100);
+  // 'control overrun' holds the robot when this many control runs ended after their deadline
+  // within the window. One late run leaves the base on the previous (barrier-checked) command for
+  // a few more milliseconds; what the reason guards against is a controller that no longer keeps
+  // its period. 1 holds on every single overrun (stricter; a VM's scheduling stalls then stop
+  // the robot every few seconds: docs/PERFORMANCE.md). At most kMaxControlOverrunsToHold.
+  uint32_t control_overruns_to_hold = 3;
+  Nanos control_overrun_window = std::chrono::milliseconds(1000);
   // Which input families are supervised. A family with no device configured yet is still
   // supervised (and so holds the robot): disabling one is for bench tests only.
   bool require_tracker = true;
   bool require_lidar = true;
   bool require_base = true;
 };
+
+inline constexpr uint32_t kMaxControlOverrunsToHold = 16;
 
 using ReasonSet = std::bitset<kReasonCount>;
 
@@ -102,6 +111,9 @@ class Supervisor {
 
  private:
   ReasonSet evaluate(const SafetyInputs& in, Nanos now);
+  // Records the overruns new since the previous update at `now`; returns how many of the
+  // recorded ones lie within the window (at most kMaxControlOverrunsToHold).
+  uint32_t recent_overruns(uint64_t new_overruns, Nanos now);
   void describe(const SafetyInputs& in, Nanos now, Reason r, std::array<char, 200>& out) const;
   static Reason primary(const ReasonSet& set, Severity min_severity);
 
@@ -113,6 +125,10 @@ class Supervisor {
   Nanos all_clear_since_ = kNever;
   uint64_t last_write_errors_ = 0;
   uint64_t last_overruns_ = 0;
+  std::array<Nanos, kMaxControlOverrunsToHold> overrun_times_{};  // ring, newest at overrun_head_
+  size_t overrun_head_ = 0;
+  size_t overrun_count_ = 0;         // valid entries in the ring
+  uint32_t overruns_in_window_ = 0;  // at the latest update, for the log line
   bool counters_seen_ = false;
 };
 

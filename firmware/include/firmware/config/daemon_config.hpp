@@ -92,6 +92,8 @@ struct DaemonConfig {
     int64_t costmap_max_age_ms = 0;
     int64_t base_feedback_timeout_ms = 0;
     int64_t control_stall_timeout_ms = 0;
+    int64_t control_overruns_to_hold = 0;
+    int64_t control_overrun_window_ms = 0;
     double stop_linear_decel_mps2 = 0;
     double stop_angular_decel_radps2 = 0;
     int64_t stop_max_time_ms = 0;
