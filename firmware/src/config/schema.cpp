@@ -575,9 +575,10 @@ std::vector<FieldSpec> build() {
        {}},
       {"supervisor.control_overrun_window_ms",
        "ms",
-       "The window in which control_overruns_to_hold overruns are counted.",
+       "The window in which control_overruns_to_hold overruns are counted (at least ten control "
+       "periods).",
        FIELD(supervisor.control_overrun_window_ms),
-       10,
+       100,
        60000,
        {}},
       {"supervisor.stop_linear_decel_mps2",
