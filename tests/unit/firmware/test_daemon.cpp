@@ -14,6 +14,8 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include "firmware/config/config_loader.hpp"
 #include "firmware/daemon.hpp"
@@ -202,6 +204,57 @@ TEST(Daemon, StopsPingingTheWatchdogWhenControlStalls) {
     all += m + " / ";
   EXPECT_GE(count(before, "WATCHDOG=1"), 9) << all;
   EXPECT_LE(count(after, "WATCHDOG=1"), 2) << "at most the pings before the stall was seen";
+}
+
+namespace {
+
+// The control task runs late (15 ms of virtual work, past its 10 ms deadline) at the given
+// times; returns whether 'control overrun' was among the supervisor's reasons at 1.5 s, and the
+// scheduler's overrun count. Through the executor's statistics and the daemon's supervisor task,
+// as on the robot.
+std::pair<bool, uint64_t> overrun_reason_after(const std::vector<core::Nanos>& late_at) {
+  auto cfg = defaults();
+  hal::SimClock clock;
+  hal::SystemdNotifier notifier;
+  firmware::Daemon daemon(cfg, notifier);
+  auto tasks = daemon.bindings();
+  size_t control = 0;
+  for (size_t i = 0; i < tasks.size(); ++i) {
+    if (tasks[i].spec.name != "control") continue;
+    control = i;
+    auto real = tasks[i].fn;
+    tasks[i].fn = [&clock, real, late_at](const core::Tick& tick) {
+      real(tick);
+      for (const core::Nanos at : late_at) {
+        if (tick.now == at) clock.sleep_until(tick.now + 15ms);
+      }
+    };
+    tasks[i].spec.group = firmware::kGroupPlanning;  // its own thread: the supervisor runs on
+  }
+  firmware::Executor ex(clock, firmware::group_table(), tasks);
+  daemon.attach(ex);
+  daemon.mark_initialized();
+  clock.set_horizon(1500ms);
+  ex.start(0s, false);
+  clock.wait_until_idle_at(1500ms);
+  const uint32_t mask = daemon.safety().read()->value.active_mask;
+  ex.stop();
+  const bool overrun = (mask >> core::reason_index(core::Reason::kControlOverrun)) & 1U;
+  return {overrun, ex.stats(control).overruns()};
+}
+
+}  // namespace
+
+TEST(Daemon, OneLateControlRunIsCountedButThreeWithinASecondAreAHoldReason) {
+  const auto [one_reason, one_count] = overrun_reason_after({1000ms});
+  EXPECT_EQ(one_count, 1U);
+  EXPECT_FALSE(one_reason) << "a single late step is counted, not a hold (3 within 1 s)";
+  const auto [three_reason, three_count] = overrun_reason_after({1000ms, 1200ms, 1400ms});
+  EXPECT_EQ(three_count, 3U);
+  EXPECT_TRUE(three_reason);
+  const auto [spread_reason, spread_count] = overrun_reason_after({100ms, 700ms, 1400ms});
+  EXPECT_EQ(spread_count, 3U);
+  EXPECT_FALSE(spread_reason) << "three overruns spread over 1.3 s";
 }
 
 TEST(Daemon, ShutdownStopsTheRobotBeforeReportingComplete) {
