@@ -228,6 +228,8 @@ TEST(Supervisor, FaultOutranksHold) {
   EXPECT_TRUE(out.active[core::reason_index(Reason::kTrackerSilent)]);
 }
 
+namespace {
+
 // Overruns at the given offsets (from the harness's time when called) while every other input
 // is healthy; returns the last output. At each offset the scheduler's cumulative counter
 // (h.overruns_) grows by `per_tick`.
@@ -246,6 +248,14 @@ core::SupervisorOutput overruns_at(Harness& h, const std::vector<Nanos>& offsets
     return in;
   });
 }
+
+// Still holding after `still_held` of healthy inputs, ACTIVE again 200 ms later.
+void expect_held_then_resumed(Harness& h, Nanos still_held) {
+  EXPECT_EQ(h.run_healthy(still_held).state, SafetyState::kHold);
+  EXPECT_EQ(h.run_healthy(200ms).state, SafetyState::kActive);
+}
+
+}  // namespace
 
 TEST(Supervisor, ASingleControlOverrunIsCountedButDoesNotHold) {
   Harness h;  // the default: 3 within 1 s
@@ -280,10 +290,7 @@ TEST(Supervisor, ControlOverrunsWithinTheWindowHoldWithTheCountThenResume) {
             "control overruns 3 in the last 1000 ms (limit 3; total 3)");
   // The condition lasts until the first of the three leaves the window (110 ms later), then
   // resume_after (1 s) of clear.
-  out = h.run_healthy(1000ms);
-  EXPECT_EQ(out.state, SafetyState::kHold);
-  out = h.run_healthy(200ms);
-  EXPECT_EQ(out.state, SafetyState::kActive);
+  expect_held_then_resumed(h, 1000ms);
 }
 
 TEST(Supervisor, SeveralOverrunsBetweenTwoUpdatesCountEach) {
@@ -299,14 +306,11 @@ TEST(Supervisor, ALimitOfOneHoldsOnEveryOverrun) {
   cfg.control_overruns_to_hold = 1;
   Harness h(cfg);
   h.arm();
-  auto out = overruns_at(h, {10ms}, 10ms);
+  const auto out = overruns_at(h, {10ms}, 10ms);
   EXPECT_EQ(out.state, SafetyState::kHold);
   EXPECT_EQ(out.reason, Reason::kControlOverrun);
   // The overrun counts for the window (1 s), then resume_after (1 s) of clear.
-  out = h.run_healthy(1900ms);
-  EXPECT_EQ(out.state, SafetyState::kHold);
-  out = h.run_healthy(200ms);
-  EXPECT_EQ(out.state, SafetyState::kActive);
+  expect_held_then_resumed(h, 1900ms);
 }
 
 TEST(Supervisor, AnOutOfRangeOverrunLimitIsClampedNotForever) {
