@@ -158,6 +158,25 @@ TEST(Daemon, PingsTheWatchdogWhileControlRuns) {
   EXPECT_LE(pings, 11);
 }
 
+namespace {
+
+// Replaces the control task's function by wrap(its function) and gives it its own thread (the
+// planning group's), so the supervisor's realtime group runs on whatever the wrapper does.
+// Returns the control task's index.
+template <typename Wrap>
+size_t wrap_control_task(std::vector<firmware::TaskBinding>& tasks, Wrap wrap) {
+  size_t control = tasks.size();
+  for (size_t i = 0; i < tasks.size(); ++i) {
+    if (tasks[i].spec.name != "control") continue;
+    control = i;
+    tasks[i].fn = wrap(tasks[i].fn);
+    tasks[i].spec.group = firmware::kGroupPlanning;
+  }
+  return control;
+}
+
+}  // namespace
+
 TEST(Daemon, StopsPingingTheWatchdogWhenControlStalls) {
   setenv("WATCHDOG_USEC", "400000", 1);
   setenv("WATCHDOG_PID", std::to_string(getpid()).c_str(), 1);
@@ -171,16 +190,12 @@ TEST(Daemon, StopsPingingTheWatchdogWhenControlStalls) {
     hal::SystemdNotifier notifier;
     firmware::Daemon daemon(cfg, notifier);
     auto tasks = daemon.bindings();
-    for (auto& t : tasks) {
-      if (t.spec.name == "control") {
-        auto real = t.fn;
-        t.fn = [&clock, real](const core::Tick& tick) {
-          if (tick.now >= 1s) clock.sleep_until(tick.now + 1h);
-          real(tick);
-        };
-        t.spec.group = firmware::kGroupPlanning;  // its own thread, so the supervisor runs on
-      }
-    }
+    wrap_control_task(tasks, [&clock](const firmware::TaskFn& real) {
+      return [&clock, real](const core::Tick& tick) {
+        if (tick.now >= 1s) clock.sleep_until(tick.now + 1h);
+        real(tick);
+      };
+    });
     firmware::Executor ex(clock, firmware::group_table(), tasks);
     daemon.attach(ex);
     daemon.mark_initialized();
@@ -218,19 +233,14 @@ std::pair<bool, uint64_t> overrun_reason_after(const std::vector<core::Nanos>& l
   hal::SystemdNotifier notifier;
   firmware::Daemon daemon(cfg, notifier);
   auto tasks = daemon.bindings();
-  size_t control = 0;
-  for (size_t i = 0; i < tasks.size(); ++i) {
-    if (tasks[i].spec.name != "control") continue;
-    control = i;
-    auto real = tasks[i].fn;
-    tasks[i].fn = [&clock, real, late_at](const core::Tick& tick) {
+  const size_t control = wrap_control_task(tasks, [&clock, &late_at](const firmware::TaskFn& real) {
+    return [&clock, real, late_at](const core::Tick& tick) {
       real(tick);
       for (const core::Nanos at : late_at) {
         if (tick.now == at) clock.sleep_until(tick.now + 15ms);
       }
     };
-    tasks[i].spec.group = firmware::kGroupPlanning;  // its own thread: the supervisor runs on
-  }
+  });
   firmware::Executor ex(clock, firmware::group_table(), tasks);
   daemon.attach(ex);
   daemon.mark_initialized();
