@@ -182,6 +182,7 @@ core::MppiConfig mppi_config(const DaemonConfig& cfg) {
   c.ellipse = core::Ellipse{cfg.interactive_space.ellipse_a_m, cfg.interactive_space.ellipse_b_m};
   c.limits =
       core::TwistLimits{cfg.limits.vx_max_mps, cfg.limits.vy_max_mps, cfg.limits.wz_max_radps};
+  c.reverse_speed_max_mps = m.reverse_speed_max_mps;
   c.closing = closing_speed_config(cfg);
   c.linear_accel_mps2 = cfg.limits.linear_accel_max_mps2;
   c.angular_accel_radps2 = cfg.limits.angular_accel_max_radps2;

@@ -26,6 +26,17 @@ Twist clip(const Twist& u, const TwistLimits& l) {
                std::clamp(u.wz, -l.wz, l.wz)};
 }
 
+// The plan's box: limits, with vx no lower than -reverse_speed_max_mps.
+double plan_vx_min(const MppiConfig& c) {
+  return -std::clamp(c.reverse_speed_max_mps, 0.0, c.limits.vx);
+}
+
+Twist clip_plan(const Twist& u, const MppiConfig& c) {
+  Twist out = clip(u, c.limits);
+  out.vx = std::max(out.vx, plan_vx_min(c));
+  return out;
+}
+
 // How deep the segment from -> to runs into an ellipse (semi-axes a, b) centred at `centre` with
 // heading (c, s): the least normalised radius on it (1 on the ellipse, 0 at its centre). In
 // the ellipse's normalised frame the segment stays a segment and the ellipse a unit circle.
@@ -315,6 +326,7 @@ void Mppi::rollout_block(size_t block, const MppiInputs& in) {
   const float two_pi = 6.283185307f;
   const float inv_two_pi = 1.0f / two_pi;
   const auto lvx = static_cast<float>(cfg_.limits.vx);
+  const auto lvx_min = static_cast<float>(plan_vx_min(cfg_));
   const auto lvy = static_cast<float>(cfg_.limits.vy);
   const auto lwz = static_cast<float>(cfg_.limits.wz);
   const auto dv = static_cast<float>(cfg_.linear_accel_mps2 * cfg_.step_s);
@@ -405,7 +417,7 @@ void Mppi::rollout_block(size_t block, const MppiInputs& in) {
     for (size_t j = 0; j < kL; ++j) {
       // The sampled control, in the velocity box and reachable from the previous one with the
       // base's accelerations (so the rollouts predict what the base will actually do).
-      float vx = std::clamp(mvx + s0 * n0[j], -lvx, lvx);
+      float vx = std::clamp(mvx + s0 * n0[j], lvx_min, lvx);
       float vy = std::clamp(mvy + s1 * n1[j], -lvy, lvy);
       float wz = std::clamp(mwz + s2 * n2[j], -lwz, lwz);
       vx = std::clamp(vx, pvx[j] - dv, pvx[j] + dv);
@@ -658,9 +670,9 @@ MppiOutput Mppi::step(const MppiInputs& in) {
   for (size_t k = 0; k < mean_.size(); ++k) {
     const Twist& d = update_[k];
     Twist& mu = mean_[k];
-    mu = clip(Twist{mu.vx + cfg_.sigma[0] * d.vx, mu.vy + cfg_.sigma[1] * d.vy,
-                    mu.wz + cfg_.sigma[2] * d.wz},
-              cfg_.limits);
+    mu = clip_plan(Twist{mu.vx + cfg_.sigma[0] * d.vx, mu.vy + cfg_.sigma[1] * d.vy,
+                         mu.wz + cfg_.sigma[2] * d.wz},
+                   cfg_);
   }
   if (cfg_.smooth && mean_.size() >= 3) {
     scratch_ = mean_;

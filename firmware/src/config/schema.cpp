@@ -943,6 +943,16 @@ std::vector<FieldSpec> build() {
        0.0,
        1000.0,
        {}},
+      {"mppi.reverse_speed_max_mps",
+       "m/s",
+       "The plan's largest backward speed (not in the paper; Nav2's MPPI has vx_min): samples and "
+       "mean reverse no faster (nor faster than limits.vx_max_mps). The barrier's repair and the "
+       "closing-speed limit may still back off at limits.vx_max_mps to keep the person safe. "
+       "docs/EVALUATION.md, twenty-eighth session.",
+       FIELD(mppi.reverse_speed_max_mps),
+       0.0,
+       3.0,
+       {}},
       {"mppi.threads",
        "count",
        "OpenMP threads for the samples (the control task's CPU share).",

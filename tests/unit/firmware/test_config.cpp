@@ -290,6 +290,19 @@ TEST(Config, TheTrackingFrameIsAChoiceThatReachesTheController) {
   EXPECT_EQ(firmware::mppi_config(*r.config).tracking_frame, core::TrackingFrame::kRobot);
 }
 
+TEST(Config, ThePlansReverseLimitReachesTheControllerAndIsBounded) {
+  EXPECT_DOUBLE_EQ(
+      firmware::mppi_config(*firmware::load_default_config().config).reverse_speed_max_mps, 1.8)
+      << "the default: as fast as forward (limits.vx_max_mps)";
+  const auto r = load_config_text("mppi:\n  reverse_speed_max_mps: 0.6\n", "test.yaml");
+  ASSERT_TRUE(r.ok()) << r.errors[0].to_string();
+  EXPECT_DOUBLE_EQ(firmware::mppi_config(*r.config).reverse_speed_max_mps, 0.6);
+  expect_error(load_config_text("mppi:\n  reverse_speed_max_mps: -0.1\n", "test.yaml"), 2,
+               "mppi.reverse_speed_max_mps", "out of range [0, 3]");
+  expect_error(load_config_text("mppi:\n  reverse_speed_max_mps: 3.5\n", "test.yaml"), 2,
+               "mppi.reverse_speed_max_mps", "out of range [0, 3]");
+}
+
 TEST(Config, TheSwitchCostReachesTheSelectorAndMustNotBeNegative) {
   const auto r = load_config_text("objective:\n  switch_cost: 0.05\n", "test.yaml");
   ASSERT_TRUE(r.ok());

@@ -59,6 +59,13 @@ struct MppiConfig {
   double c_safe = 5000.0;
   Ellipse ellipse;
   TwistLimits limits;
+  // The plan's largest backward speed (m/s; not in the paper; Nav2's MPPI has vx_min): the
+  // samples and the mean reverse no faster than this (nor than limits.vx). The barrier's repair
+  // and the closing-speed limit may still back the robot off up to limits.vx: they keep the
+  // person safe. Among pedestrians walking at the robot, a plan free to reverse backs away from
+  // them, and from the person, at full speed; a slower reverse leaves stepping aside the cheaper
+  // way (docs/EVALUATION.md, twenty-eighth session).
+  double reverse_speed_max_mps = 3.0;
   // Speed and separation toward the person, applied to the repaired command (closing_speed.hpp;
   // robot_decel_mps2 = 0: off).
   ClosingSpeedConfig closing;

@@ -154,6 +154,7 @@ struct DaemonConfig {
     double noise_vy_mps = 0;
     double noise_wz_radps = 0;
     double terminal_weight = 0;
+    double reverse_speed_max_mps = 0;
     int64_t threads = 0;
     int64_t seed = 0;
   } mppi;
