@@ -130,6 +130,10 @@ def main():
     ap.add_argument("--turn-rad-s", type=float, default=0.5)
     ap.add_argument("--pedestrian-m", type=float, default=1.5)
     args = ap.parse_args()
+    for name in ("window_s", "jump_m", "turn_rad_s", "pedestrian_m"):
+        value = getattr(args, name)
+        if not math.isfinite(value) or value < 0:
+            ap.error(f"--{name.replace('_', '-')} must be a finite number >= 0, not {value}")
     files = sample_files(args.paths)
     if not files:
         sys.exit(f"error_sources: no sample files in {' '.join(args.paths)}")

@@ -155,6 +155,13 @@ class ErrorSources(unittest.TestCase):
             self.assertIn("none.csv", r.stderr)
             self.assertNotIn("Traceback", r.stderr)
 
+    def test_a_threshold_that_is_not_a_distance_or_a_time_is_a_clear_error(self):
+        for flag, value in (("--window-s", "-1"), ("--jump-m", "nan"), ("--turn-rad-s", "inf")):
+            r = subprocess.run([sys.executable, SCRIPT, HERE, flag, value], capture_output=True,
+                               text=True)
+            self.assertEqual(r.returncode, 2, (flag, r.stderr))
+            self.assertIn(f"{flag} must be a finite number >= 0", r.stderr)
+
 
 if __name__ == "__main__":
     unittest.main()
