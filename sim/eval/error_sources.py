@@ -12,7 +12,9 @@ first event of this list that holds for it:
                   in the person's frame: the selector chose another point of W (a point that
                   follows the person moves with their frame and does not count);
   person turning  within --window-s of the person's heading turning faster than --turn-rad-s
-                  (q^d, fixed in their frame, swings round with them);
+                  (q^d, fixed in their frame, swings round with them); only after the turning
+                  sample, as for every event here: its error follows it (heading_bound.py's
+                  turn_share, a share of e_theta² for its bound, counts the window both sides);
   pedestrian near a pedestrian within --pedestrian-m of the robot (the robot giving way);
   steady          none of these.
 
