@@ -21,6 +21,7 @@
 #include "hal/net/udp_socket.hpp"
 #include "hal/realtime.hpp"
 #include "hal/sd_notify.hpp"
+#include "openmp_wait.hpp"
 #include "show_status.hpp"
 #include "sim/sim_run.hpp"
 #include "sim_mode.hpp"
@@ -42,7 +43,7 @@ int wait_signal(const sigset_t& set, std::chrono::milliseconds timeout) {
   return sig > 0 ? sig : 0;
 }
 
-int run(int argc, char** argv) {
+int run(int argc, char** argv, const companiond::OpenmpWaitPolicy& omp_wait) {
   CLI::App app{"companiond - companion robot daemon (Amfitrack + VLP-16 + Scout Mini)"};
   std::string config_path;
   std::string check_path;
@@ -126,6 +127,15 @@ int run(int argc, char** argv) {
                  row.spec.priority,
                  row.pending.empty() ? std::string()
                                      : " - not yet implemented: " + std::string(row.pending));
+  }
+  if (omp_wait.value.empty() && cfg.mppi.threads > 1) {
+    spdlog::warn(
+        "OpenMP: MPPI on {} threads, wait policy libgomp's default (spin) ({}); its "
+        "workers spin at the control group's priority (set OMP_WAIT_POLICY=passive)",
+        cfg.mppi.threads, omp_wait.source);
+  } else {
+    spdlog::info("OpenMP: MPPI on {} threads, wait policy {} ({})", cfg.mppi.threads,
+                 omp_wait.value.empty() ? "default" : omp_wait.value, omp_wait.source);
   }
   spdlog::info("devices: tracker '{}', lidar '{}', base '{}'", cfg.devices.tracker,
                cfg.devices.lidar, cfg.devices.base);
@@ -388,8 +398,10 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // First, before any thread: may start the process again (openmp_wait.hpp says why).
+  const companiond::OpenmpWaitPolicy omp_wait = companiond::choose_openmp_wait_policy(argv);
   try {
-    return run(argc, argv);
+    return run(argc, argv, omp_wait);
   } catch (const std::exception& e) {
     // Nothing is expected to throw past start-up; if something does, say what and fail so that
     // systemd restarts us (the base stops by itself 500 ms after the last command).

@@ -4,6 +4,7 @@
 
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -138,6 +139,33 @@ TEST(Companiond, WarnsOnceAndRunsWithoutRealTimeWhenNotRequired) {
   ASSERT_NE(first, std::string::npos) << out;
   EXPECT_EQ(out.find("running WITHOUT real-time guarantees", first + 1), std::string::npos)
       << "one warning, not one per thread";
+}
+
+// libgomp's default wait policy spins its workers at the control group's SCHED_FIFO priority
+// (firmware/companiond/openmp_wait.hpp): companiond starts itself again with passive, unless the
+// environment chose a policy, which it keeps.
+namespace {
+std::string run_briefly_with_omp_wait_policy(const char* value) {
+  if (value == nullptr) {
+    unsetenv("OMP_WAIT_POLICY");
+  } else {
+    setenv("OMP_WAIT_POLICY", value, 1);
+  }
+  ChildProcess p({COMPANIOND_PATH, "--log-sink", "console", "--duration-s", "0.2"});
+  unsetenv("OMP_WAIT_POLICY");
+  EXPECT_TRUE(p.started());
+  EXPECT_EQ(p.wait(10s), 0) << p.output();
+  return p.output();
+}
+}  // namespace
+
+TEST(Companiond, ChoosesThePassiveOpenmpWaitPolicyUnlessTheEnvironmentDoes) {
+  const std::string ours = run_briefly_with_omp_wait_policy(nullptr);
+  EXPECT_NE(ours.find("wait policy passive (companiond's default"), std::string::npos) << ours;
+  EXPECT_EQ(ours.find("companiond starting"), ours.rfind("companiond starting"))
+      << "started once after the re-exec: " << ours;
+  const std::string theirs = run_briefly_with_omp_wait_policy("active");
+  EXPECT_NE(theirs.find("wait policy active (from OMP_WAIT_POLICY"), std::string::npos) << theirs;
 }
 
 TEST(Companiond, RefusesAPolicyFileThatDoesNotLoad) {
