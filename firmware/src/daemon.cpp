@@ -300,7 +300,8 @@ void Daemon::tracker_link_events(Nanos now) {
   const bool up = !tracker_link_->failed();
   if (up != tracker_link_was_up_) {
     if (up) {
-      spdlog::info("tracker: link up: {}", rl != nullptr ? rl->events().description : "");
+      // A link that is not reopened by us (the simulator's, a test's) has no description.
+      spdlog::info("tracker: link up{}", rl != nullptr ? ": " + rl->events().description : "");
     } else {
       spdlog::warn("tracker: link lost ({}); reopening with back-off",
                    rl != nullptr ? rl->events().last_error : std::string("read/write error"));
