@@ -398,9 +398,9 @@ int run(int argc, char** argv, const companiond::OpenmpWaitPolicy& omp_wait) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // First, before any thread: may start the process again (openmp_wait.hpp says why).
-  const companiond::OpenmpWaitPolicy omp_wait = companiond::choose_openmp_wait_policy(argv);
   try {
+    // First, before any thread: may start the process again (openmp_wait.hpp says why).
+    const companiond::OpenmpWaitPolicy omp_wait = companiond::choose_openmp_wait_policy(argv);
     return run(argc, argv, omp_wait);
   } catch (const std::exception& e) {
     // Nothing is expected to throw past start-up; if something does, say what and fail so that
