@@ -145,6 +145,8 @@ TEST(Companiond, WarnsOnceAndRunsWithoutRealTimeWhenNotRequired) {
 // (firmware/companiond/openmp_wait.hpp): companiond starts itself again with passive, unless the
 // environment chose a policy, which it keeps.
 namespace {
+// The child inherits the environment; the test itself has no other thread to race with.
+// NOLINTBEGIN(concurrency-mt-unsafe)
 std::string run_briefly_with_omp_wait_policy(const char* value) {
   if (value == nullptr) {
     unsetenv("OMP_WAIT_POLICY");
@@ -153,6 +155,7 @@ std::string run_briefly_with_omp_wait_policy(const char* value) {
   }
   ChildProcess p({COMPANIOND_PATH, "--log-sink", "console", "--duration-s", "0.2"});
   unsetenv("OMP_WAIT_POLICY");
+  // NOLINTEND(concurrency-mt-unsafe)
   EXPECT_TRUE(p.started());
   EXPECT_EQ(p.wait(10s), 0) << p.output();
   return p.output();
