@@ -51,6 +51,7 @@ Costmap::Costmap(int cells, double resolution_m)
       res_(resolution_m),
       cost_(static_cast<size_t>(cells) * static_cast<size_t>(cells), 0),
       dist2_(cost_.size(), kInf),
+      row_(static_cast<size_t>(cells)),
       f_(static_cast<size_t>(cells)),
       g_(static_cast<size_t>(cells)),
       z_(static_cast<size_t>(cells) + 1),
@@ -66,21 +67,34 @@ void Costmap::build(const VoxelGrid& grid, const CostmapConfig& config, Nanos st
   oy_ = grid.origin_y();
   stamp_ = stamp;
   obstacles_ = 0;
-  // Squared distance (in cells) to the nearest obstacle column: rows, then columns.
+  // Squared distance (in cells) to the nearest obstacle column: rows, then columns. A row or
+  // column without an obstacle transforms to kInf everywhere (the parabolas' q^2 vanish in
+  // kInf's rounding), so it is filled, not transformed.
+  const auto n = static_cast<size_t>(n_);
   for (int j = 0; j < n_; ++j) {
-    for (int i = 0; i < n_; ++i) {
-      const bool obstacle = grid.column(i, j) != 0;
-      obstacles_ += obstacle ? 1U : 0U;
-      f_[static_cast<size_t>(i)] = obstacle ? 0.0f : kInf;
+    grid.row(j, row_);
+    float* out = &dist2_[static_cast<size_t>(j) * n];
+    size_t row_obstacles = 0;
+    for (size_t i = 0; i < n; ++i) {
+      const bool obstacle = row_[i] != 0;
+      row_obstacles += obstacle ? 1U : 0U;
+      f_[i] = obstacle ? 0.0f : kInf;
     }
-    edt_1d(f_.data(), &dist2_[static_cast<size_t>(j) * static_cast<size_t>(n_)], n_, v_.data(),
-           z_.data());
+    obstacles_ += row_obstacles;
+    if (row_obstacles == 0) {
+      std::fill_n(out, n, kInf);
+    } else {
+      edt_1d(f_.data(), out, n_, v_.data(), z_.data());
+    }
   }
   for (int i = 0; i < n_; ++i) {
-    for (int j = 0; j < n_; ++j) {
-      f_[static_cast<size_t>(j)] =
-          dist2_[static_cast<size_t>(j) * static_cast<size_t>(n_) + static_cast<size_t>(i)];
+    bool any = false;
+    for (size_t j = 0; j < n; ++j) {
+      const float d = dist2_[j * n + static_cast<size_t>(i)];
+      f_[j] = d;
+      any = any || d < kInf;
     }
+    if (!any) continue;  // stays kInf
     edt_1d(f_.data(), g_.data(), n_, v_.data(), z_.data());
     for (int j = 0; j < n_; ++j) {
       dist2_[static_cast<size_t>(j) * static_cast<size_t>(n_) + static_cast<size_t>(i)] =

@@ -6,16 +6,15 @@
 #include <cmath>
 #include <limits>
 
+#include "core/util/floor_to_int.hpp"
+
 namespace core {
 namespace {
 
 constexpr double kNoStep = std::numeric_limits<double>::infinity();
-
-// floor() without the libm call (the baseline x86-64 / aarch64 targets do not inline it).
-inline int64_t floor_to_int(double v) {
-  const auto i = static_cast<int64_t>(v);
-  return i - static_cast<int64_t>(v < static_cast<double>(i));  // branchless
-}
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kElevationBinRad = kPi / 180.0;
+constexpr int kElevationSearchBins = 3;  // VLP-16 beams are 2 degrees apart
 
 uint16_t stamp_units(Nanos now) {
   return static_cast<uint16_t>((now.count() / 10'000'000) & 0xFFFF);  // 10 ms
@@ -35,11 +34,12 @@ VoxelGrid::VoxelGrid(const VoxelGridConfig& config)
       mask_(static_cast<size_t>(n_) * static_cast<size_t>(n_), 0),
       stamp_(mask_.size() * static_cast<size_t>(nz_), 0),
       block_count_(static_cast<size_t>(n_ / kBlock) * static_cast<size_t>(n_ / kBlock), 0),
-      traced_(1 << 17, 0),
-      traced_scan_(traced_.size(), 0),
+      traced_(1 << 17),
       depth_(static_cast<size_t>(kAzimuthBins) * kElevationBins, -1.0f),
       azimuth_origin_(kAzimuthBins),
-      azimuth_seen_(kAzimuthBins, 0) {}
+      azimuth_seen_(kAzimuthBins, 0),
+      azimuth_bins_(kAzimuthBins),
+      elevation_bins_(kElevationBinRad) {}
 
 size_t VoxelGrid::block_of(size_t col) const {
   const size_t i = col % static_cast<size_t>(n_);
@@ -230,23 +230,53 @@ void VoxelGrid::insert(std::span<const Ray> rays, const Pose2& robot,
   // of the same scan.
   ++scan_serial_;
   const size_t table_mask = traced_.size() - 1;
-  for (const Ray& r : rays) {
-    const int64_t cx = static_cast<int64_t>(std::floor(r.end.x / res_));
-    const int64_t cy = static_cast<int64_t>(std::floor(r.end.y / res_));
-    const int cz = static_cast<int>(std::floor((r.end.z - cfg_.z_min_m) / res_));
+  // The end voxel and its table slot, computed kAhead rays early so that the slot's cache line is
+  // fetched while the rays before it are traced (the table is larger than the caches: each probe
+  // was a miss).
+  struct EndVoxel {
+    int64_t cx, cy;
+    int cz;
+    uint64_t key;
+    size_t slot;
+  };
+  auto end_voxel = [&](const Ray& r) {
+    EndVoxel e{};
+    e.cx = floor_to_int(r.end.x / res_);
+    e.cy = floor_to_int(r.end.y / res_);
+    e.cz = static_cast<int>(floor_to_int((r.end.z - cfg_.z_min_m) / res_));
     // One ray per end voxel and scan (a table stamped with the scan's serial: no clearing pass).
-    const uint64_t key = (static_cast<uint64_t>(cx) & 0x1FFFFF) |
-                         (static_cast<uint64_t>(cy) & 0x1FFFFF) << 21 |
-                         (static_cast<uint64_t>(cz + 1024) & 0x1FFFFF) << 42;
-    size_t h = static_cast<size_t>((key * 0x9E3779B97F4A7C15ULL) >> 40) & table_mask;
+    e.key = (static_cast<uint64_t>(e.cx) & 0x1FFFFF) |
+            (static_cast<uint64_t>(e.cy) & 0x1FFFFF) << 21 |
+            (static_cast<uint64_t>(e.cz + 1024) & 0x1FFFFF) << 42;
+    e.slot = static_cast<size_t>((e.key * 0x9E3779B97F4A7C15ULL) >> 40) & table_mask;
+    return e;
+  };
+  constexpr size_t kAhead = 8;
+  std::array<EndVoxel, kAhead> ahead{};
+  for (size_t i = 0; i < std::min(kAhead, rays.size()); ++i) {
+    ahead[i] = end_voxel(rays[i]);
+    __builtin_prefetch(&traced_[ahead[i].slot]);
+  }
+  for (size_t i = 0; i < rays.size(); ++i) {
+    const Ray& r = rays[i];
+    const EndVoxel e = ahead[i % kAhead];
+    if (i + kAhead < rays.size()) {
+      ahead[i % kAhead] = end_voxel(rays[i + kAhead]);
+      __builtin_prefetch(&traced_[ahead[i % kAhead].slot]);
+    }
+    const int64_t cx = e.cx, cy = e.cy;
+    const int cz = e.cz;
+    const uint64_t key = e.key;
+    size_t h = e.slot;
     bool seen = false;
     for (size_t probe = 0; probe < 8; ++probe, h = (h + 1) & table_mask) {
-      if (traced_scan_[h] != scan_serial_) {
-        traced_scan_[h] = scan_serial_;
-        traced_[h] = key;
+      TracedSlot& slot = traced_[h];
+      if (slot.scan != scan_serial_) {
+        slot.scan = scan_serial_;
+        slot.key = key;
         break;
       }
-      if (traced_[h] == key) {
+      if (slot.key == key) {
         seen = true;
         break;
       }
@@ -293,13 +323,13 @@ void VoxelGrid::insert(std::span<const Ray> rays, const Pose2& robot,
         continue;
       }
     }
-    const int64_t cx = static_cast<int64_t>(std::floor(r.end.x / res_));
-    const int64_t cy = static_cast<int64_t>(std::floor(r.end.y / res_));
+    const int64_t cx = floor_to_int(r.end.x / res_);
+    const int64_t cy = floor_to_int(r.end.y / res_);
     if (cx < ox_ || cx >= ox_ + n_ || cy < oy_ || cy >= oy_ + n_) {
       ++stats_.out_of_window;
       continue;
     }
-    const int cz = static_cast<int>(std::floor((r.end.z - cfg_.z_min_m) / res_));
+    const int cz = static_cast<int>(floor_to_int((r.end.z - cfg_.z_min_m) / res_));
     const size_t col = slot(cx, cy);
     set_column(col, mask_[col] | uint64_t{1} << cz);
     stamp_[col * static_cast<size_t>(nz_) + static_cast<size_t>(cz)] = stamp;
@@ -340,13 +370,6 @@ void VoxelGrid::clear_person(const PersonSweep& person) {
   }
 }
 
-namespace {
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kAzimuthBinRad = 2.0 * kPi / 720.0;
-constexpr double kElevationBinRad = kPi / 180.0;
-constexpr int kElevationSearchBins = 3;  // VLP-16 beams are 2 degrees apart
-}  // namespace
-
 // Ray casting frees the voxels a ray crosses, at the heights it crosses them. From a moving robot
 // the beams cross a vacated place at other heights than those that marked it, so a walking
 // pedestrian left a trail for decay_s: a wall along the path of anyone the robot follows. The
@@ -364,11 +387,9 @@ void VoxelGrid::clear_seen_through(std::span<const Ray> rays, uint16_t stamp) {
     const double vz = r.end.z - r.origin.z;
     const double h = std::hypot(vx, vy);
     if (!(h > 1e-6)) continue;
-    const double el = std::atan2(vz, h);
-    const auto ei = static_cast<int>(floor_to_int(el / kElevationBinRad)) + kElevationBins / 2;
+    const auto ei = static_cast<int>(elevation_bins_.bin(vz, h)) + kElevationBins / 2;
     if (ei < 0 || ei >= kElevationBins) continue;
-    const auto ai =
-        static_cast<int>(floor_to_int((std::atan2(vy, vx) + kPi) / kAzimuthBinRad)) % kAzimuthBins;
+    const int ai = azimuth_bins_.bin(vx, vy);
     float& d = depth_[static_cast<size_t>(ai) * kElevationBins + static_cast<size_t>(ei)];
     const auto range = static_cast<float>(std::hypot(h, vz));
     if (azimuth_seen_[static_cast<size_t>(ai)] == 0) {
@@ -465,26 +486,28 @@ void VoxelGrid::clear_seen_through(std::span<const Ray> rays, uint16_t stamp) {
 }
 
 VoxelGrid::ColumnView VoxelGrid::column_view(const Point3& origin, double x, double y) const {
-  auto azimuth_bin_of = [](double dx, double dy) {
-    return static_cast<int>(floor_to_int((std::atan2(dy, dx) + kPi) / kAzimuthBinRad)) %
-           kAzimuthBins;
-  };
   // The bin from the scan's mean origin, then again from where the sensor was at that azimuth.
   const Point3& o =
-      azimuth_origin_[static_cast<size_t>(azimuth_bin_of(x - origin.x, y - origin.y))];
+      azimuth_origin_[static_cast<size_t>(azimuth_bins_.bin(x - origin.x, y - origin.y))];
   const double dx = x - o.x, dy = y - o.y;
-  return {azimuth_bin_of(dx, dy), std::hypot(dx, dy), o.z};
+  return {azimuth_bins_.bin(dx, dy), std::hypot(dx, dy), o.z};
 }
 
 VoxelGrid::Visibility VoxelGrid::visibility(const ColumnView& view, double z) const {
   const int ai = view.azimuth_bin;
   const double h = view.horizontal_m;
   const double dz = z - view.sensor_z_m;
-  const double el = std::atan2(dz, h);
+  const int64_t elevation_bin = elevation_bins_.bin(dz, h);
   const auto range = static_cast<float>(std::hypot(h, dz));
   const auto margin = static_cast<float>(cfg_.seen_through_margin_m);
-  const auto e0 = static_cast<int>(floor_to_int(el / kElevationBinRad)) + kElevationBins / 2;
-  const bool above_view = el > cfg_.view_top_rad + 0.5 * kElevationBinRad;
+  const auto e0 = static_cast<int>(elevation_bin) + kElevationBins / 2;
+  // Above the view when the elevation exceeds the top: the bin says so unless the top lies within
+  // it (1e-9 rad: far beyond the elevation's rounding), then the angle itself.
+  const double view_top = cfg_.view_top_rad + 0.5 * kElevationBinRad;
+  const double bin_low = static_cast<double>(elevation_bin) * kElevationBinRad;
+  const bool above_view =
+      bin_low > view_top + 1e-9 ||
+      (bin_low + kElevationBinRad >= view_top - 1e-9 && std::atan2(dz, h) > view_top);
   if (e0 < 0 || (!above_view && e0 >= kElevationBins)) return Visibility::kUnseen;
   // Where did the nearest beams end, at or below the voxel and at or above it (within the beam
   // spacing), in its azimuth bin and the two beside it? Above the sensor's view: the top beam,
@@ -559,6 +582,16 @@ uint64_t VoxelGrid::column(int i, int j) const {
   return mask_[slot(ox_ + i, oy_ + j)];
 }
 
+void VoxelGrid::row(int j, std::span<uint64_t> out) const {
+  const auto n = static_cast<size_t>(n_);
+  const size_t first = slot(ox_, oy_ + j);  // window column 0 of the row
+  const size_t row_start = first - first % n;
+  const size_t wrapped = n - first % n;  // columns before the storage row wraps
+  std::copy_n(mask_.begin() + static_cast<std::ptrdiff_t>(first), wrapped, out.begin());
+  std::copy_n(mask_.begin() + static_cast<std::ptrdiff_t>(row_start), n - wrapped,
+              out.begin() + static_cast<std::ptrdiff_t>(wrapped));
+}
+
 bool VoxelGrid::occupied(double x, double y, double z) const {
   const int64_t cx = static_cast<int64_t>(std::floor(x / res_));
   const int64_t cy = static_cast<int64_t>(std::floor(y / res_));
@@ -571,9 +604,9 @@ bool VoxelGrid::occupied(double x, double y, double z) const {
 
 size_t VoxelGrid::memory_bytes() const {
   return mask_.capacity() * sizeof(uint64_t) + stamp_.capacity() * sizeof(uint16_t) +
-         block_count_.capacity() * sizeof(uint16_t) + traced_.capacity() * sizeof(uint64_t) +
-         traced_scan_.capacity() * sizeof(uint32_t) + depth_.capacity() * sizeof(float) +
-         azimuth_origin_.capacity() * sizeof(Point3) + azimuth_seen_.capacity();
+         block_count_.capacity() * sizeof(uint16_t) + traced_.capacity() * sizeof(TracedSlot) +
+         depth_.capacity() * sizeof(float) + azimuth_origin_.capacity() * sizeof(Point3) +
+         azimuth_seen_.capacity();
 }
 
 size_t VoxelGrid::occupied_count() const {

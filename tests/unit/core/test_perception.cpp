@@ -181,6 +181,30 @@ TEST(VoxelGrid, WindowRollsWithTheRobotWithoutMovingObstacles) {
   EXPECT_EQ(g.occupied_count(), 0U);
 }
 
+// The costmap reads the grid a row at a time: the rows must be the columns in window order
+// wherever the rolled window's storage wraps (here in x and in y).
+TEST(VoxelGrid, RowsAreTheWindowsColumnsWhereverTheStorageWraps) {
+  core::VoxelGrid g(small_grid());
+  g.recentre(0, 0);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-3.9, 3.9);
+  std::vector<Ray> rays;
+  for (int k = 0; k < 300; ++k)
+    rays.push_back(ray_to(u(rng), u(rng), 0.5));
+  g.insert(rays, {}, std::nullopt, 1s);
+  g.recentre(1.35, -2.05);  // wraps the storage in both directions
+  std::vector<uint64_t> row(static_cast<size_t>(g.cells_xy()));
+  size_t occupied_columns = 0;
+  for (int j = 0; j < g.cells_xy(); ++j) {
+    g.row(j, row);
+    for (int i = 0; i < g.cells_xy(); ++i) {
+      ASSERT_EQ(row[static_cast<size_t>(i)], g.column(i, j)) << i << "," << j;
+      occupied_columns += row[static_cast<size_t>(i)] != 0 ? 1U : 0U;
+    }
+  }
+  EXPECT_GT(occupied_columns, 100U);
+}
+
 TEST(VoxelGrid, MemoryDoesNotGrowAndDecayedVoxelsAreFreed) {
   // A robot driving a long way through random clutter for 100 s of scans.
   core::VoxelGrid g(small_grid());

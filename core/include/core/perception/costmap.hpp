@@ -134,6 +134,7 @@ class Costmap {
       std::vector<CellRange>(1, CellRange{kCostLethal, kCostLethal});
   // distance transform work buffers
   std::vector<float> dist2_;
+  std::vector<uint64_t> row_;  // one grid row's column masks
   std::vector<float> f_, g_, z_;
   std::vector<int> v_;
   // cost by squared distance in cells, for the configuration it was made for

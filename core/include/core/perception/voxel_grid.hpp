@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "core/geometry/pose2.hpp"
+#include "core/perception/angle_bins.hpp"
 #include "core/time.hpp"
 
 namespace core {
@@ -106,6 +107,9 @@ class VoxelGrid {
   [[nodiscard]] double origin_y() const { return static_cast<double>(oy_) * res_; }
   // Occupancy mask of the column at window cell (i, j), 0 <= i, j < cells_xy(); bit k = z layer.
   [[nodiscard]] uint64_t column(int i, int j) const;
+  // The masks of window row j (0 <= j < cells_xy()), columns i = 0 .. cells_xy() - 1, into out
+  // (cells_xy() entries): two contiguous runs of the storage, no wrapping per column.
+  void row(int j, std::span<uint64_t> out) const;
   [[nodiscard]] bool occupied(double x, double y, double z) const;
   [[nodiscard]] size_t occupied_count() const;
   // Bytes held by the grid's buffers (fixed at construction).
@@ -148,8 +152,12 @@ class VoxelGrid {
   std::vector<uint16_t> block_count_;
   // End voxels already traced in this scan (open addressing, cleared per insert): rays that end
   // in the same voxel cross the same voxels to within a fraction of one, so one is cast.
-  std::vector<uint64_t> traced_;
-  std::vector<uint32_t> traced_scan_;
+  // Key and scan serial side by side: a probe touches one cache line, not two.
+  struct TracedSlot {
+    uint64_t key = 0;
+    uint32_t scan = 0;
+  };
+  std::vector<TracedSlot> traced_;
   uint32_t scan_serial_ = 0;
   // The scan's depth image (nearest range per azimuth x elevation bin, < 0: no beam) and the
   // sensor's origin per azimuth bin (it moves during a revolution).
@@ -158,6 +166,8 @@ class VoxelGrid {
   std::vector<float> depth_;
   std::vector<Point3> azimuth_origin_;
   std::vector<uint8_t> azimuth_seen_;  // this scan has a ray in the bin
+  AzimuthBins azimuth_bins_;
+  ElevationBins elevation_bins_;
   VoxelGridStats stats_;
 };
 
