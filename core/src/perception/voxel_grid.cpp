@@ -160,24 +160,73 @@ void VoxelGrid::clear_ray(const Ray& r, int64_t end_cx, int64_t end_cy, int end_
   int64_t sj = storage(cy, oy_, sj0);
   const double block_m = kBlock * res_;
   const int64_t blocks_per_row = n_ / kBlock;
+  // The walk over empty blocks (below) steps block to block only where rounding cannot decide
+  // the entry cell: the ray passes a face by eps times its extent across it, which must be well
+  // above the rounding of positions this far from odom's origin (~1e-15 of their size), and it
+  // crosses the face at least as far from the face's ends.
+  const double rounding_m = 1e-13 * (1.0 + std::abs(x0) + std::abs(y0) + adx + ady);
+  const bool cross_x_ok = adx * eps > rounding_m;
+  const bool cross_y_ok = ady * eps > rounding_m;
+  const double corner_margin_m = 4.0 * rounding_m + (adx + ady) * eps * 4.0;
   double t = t0;
   while (t < t1) {
     const auto col = static_cast<size_t>(sj * n_ + si);
     if (block_count_[static_cast<size_t>((sj >> kBlockShift) * blocks_per_row +
                                          (si >> kBlockShift))] == 0) {
       // Nothing to clear in this block: continue from where the ray leaves it.
-      const auto bx =
-          static_cast<double>(cx >> kBlockShift);  // arithmetic shift: floor(cx / kBlock)
-      const auto by = static_cast<double>(cy >> kBlockShift);
-      const double tx = adx < 1e-12 ? kNoStep : ((bx + (sx > 0 ? 1 : 0)) * block_m - x0) * inv_dx;
-      const double ty = ady < 1e-12 ? kNoStep : ((by + (sy > 0 ? 1 : 0)) * block_m - y0) * inv_dy;
-      const double t_exit = std::min(tx, ty);
-      if (t_exit >= t1) break;
+      int64_t bx = cx >> kBlockShift;  // arithmetic shift: floor(cx / kBlock)
+      int64_t by = cy >> kBlockShift;
+      double t_exit = 0.0;
+      bool exit_x = false;  // it leaves the block through an x face
+      for (;;) {
+        const double tx =
+            adx < 1e-12 ? kNoStep
+                        : ((static_cast<double>(bx) + (sx > 0 ? 1 : 0)) * block_m - x0) * inv_dx;
+        const double ty =
+            ady < 1e-12 ? kNoStep
+                        : ((static_cast<double>(by) + (sy > 0 ? 1 : 0)) * block_m - y0) * inv_dy;
+        t_exit = std::min(tx, ty);
+        exit_x = !(ty < tx);  // std::min's choice
+        if (t_exit >= t1) return;
+        // The block it enters, when the entry cell computed below certainly lies in it (the ray
+        // crosses the face away from the corners, and past the face by more than rounding), the
+        // block lies wholly in the window and it is empty too: on to its exit without that
+        // computation. Otherwise (or for the first block with something in it) the entry cell is
+        // computed below, exactly as for every block when the walk is off.
+        if (!block_walk_) break;
+        const bool via_x = tx < ty;  // (a tie is a corner: the general entry)
+        if (!(via_x ? cross_x_ok : cross_y_ok)) break;
+        const double along = via_x ? y0 + dy * tx : x0 + dx * ty;  // the other coordinate there
+        const double face_lo = static_cast<double>(via_x ? by : bx) * block_m;
+        if (!(std::min(along - face_lo, face_lo + block_m - along) > corner_margin_m)) break;
+        const int64_t nbx = via_x ? bx + sx : bx;
+        const int64_t nby = via_x ? by : by + sy;
+        const int64_t first_cx = nbx * kBlock, first_cy = nby * kBlock;
+        if (first_cx < ox_ || first_cx + kBlock > ox_ + n_ || first_cy < oy_ ||
+            first_cy + kBlock > oy_ + n_) {
+          break;
+        }
+        const int64_t bsi = storage(first_cx, ox_, si0) >> kBlockShift;
+        const int64_t bsj = storage(first_cy, oy_, sj0) >> kBlockShift;
+        if (block_count_[static_cast<size_t>(bsj * blocks_per_row + bsi)] != 0) break;
+        bx = nbx;
+        by = nby;
+      }
       t = t_exit;
       const double qx = x0 + dx * (t + eps);
       const double qy = y0 + dy * (t + eps);
       cx = floor_to_int(qx * inv_res);
       cy = floor_to_int(qy * inv_res);
+      if ((cx >> kBlockShift) == bx && (cy >> kBlockShift) == by) {
+        // Still in the block it leaves: its move past the face (eps times its extent across it)
+        // is below the rounding of its position (a ray along a block face, nearly parallel to
+        // it). Across the face by hand, or it would re-enter here for ever (it did: a hang).
+        if (exit_x) {
+          cx = sx > 0 ? (bx + 1) * kBlock : bx * kBlock - 1;
+        } else {
+          cy = sy > 0 ? (by + 1) * kBlock : by * kBlock - 1;
+        }
+      }
       if (cx < ox_ || cx >= ox_ + n_ || cy < oy_ || cy >= oy_ + n_) break;
       si = storage(cx, ox_, si0);
       sj = storage(cy, oy_, sj0);

@@ -115,6 +115,10 @@ class VoxelGrid {
   // Bytes held by the grid's buffers (fixed at construction).
   [[nodiscard]] size_t memory_bytes() const;
   [[nodiscard]] const VoxelGridStats& stats() const { return stats_; }
+  // Ray clearing walks over runs of empty blocks without computing each one's entry cell where
+  // rounding cannot decide it (on: the default). Off: every block is entered by that general
+  // computation, the reference the walk must equal bit for bit (the tests compare the two).
+  void use_block_walk(bool on) { block_walk_ = on; }
 
  private:
   [[nodiscard]] size_t slot(int64_t cx, int64_t cy) const;  // odom cell -> storage column
@@ -159,6 +163,7 @@ class VoxelGrid {
   };
   std::vector<TracedSlot> traced_;
   uint32_t scan_serial_ = 0;
+  bool block_walk_ = true;
   // The scan's depth image (nearest range per azimuth x elevation bin, < 0: no beam) and the
   // sensor's origin per azimuth bin (it moves during a revolution).
   static constexpr int kAzimuthBins = 720;   // 0.5 degree
