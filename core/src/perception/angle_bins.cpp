@@ -72,6 +72,11 @@ int AzimuthBins::bin(double x, double y) const {
   return bin_by_atan2(x, y);
 }
 
+int AzimuthBins::bin(double x, double y, int hint) const {
+  if (hint >= 0 && hint < bins_ && side(hint, x, y) > 0 && side(hint + 1, x, y) < 0) return hint;
+  return bin(x, y);
+}
+
 ElevationBins::ElevationBins(double width_rad)
     : width_rad_(width_rad),
       inv_width_(1.0 / width_rad),
@@ -106,6 +111,17 @@ int64_t ElevationBins::bin(double z, double h) const {
     if (k < -max_bin_ || k >= max_bin_) break;
   }
   return bin_by_atan2(z, h);
+}
+
+int64_t ElevationBins::bin(double z, double h, int64_t hint) const {
+  if (h > 0.0 && hint >= -max_bin_ && hint < max_bin_) {
+    // z / h against the bin's tangents, multiplied out (h > 0): no division.
+    const auto lo = static_cast<size_t>(hint + max_bin_);
+    if (z - h * tan_[lo] > h * margin_[lo] && h * tan_[lo + 1] - z > h * margin_[lo + 1]) {
+      return hint;
+    }
+  }
+  return bin(z, h);
 }
 
 }  // namespace core

@@ -430,15 +430,24 @@ void VoxelGrid::clear_seen_through(std::span<const Ray> rays, uint16_t stamp) {
   std::fill(azimuth_seen_.begin(), azimuth_seen_.end(), 0);
   Point3 mean{};
   size_t used = 0;
+  // The returns come firing by firing: a firing's returns share the azimuth bin, and a laser's
+  // elevation bin is that of the return a firing (16 returns) before. Those are tried first.
+  int azimuth_hint = -1;
+  std::array<int64_t, 16> elevation_hint{};
+  elevation_hint.fill(std::numeric_limits<int64_t>::min());
+  size_t index = 0;
   for (const Ray& r : rays) {
     const double vx = r.end.x - r.origin.x;
     const double vy = r.end.y - r.origin.y;
     const double vz = r.end.z - r.origin.z;
     const double h = std::hypot(vx, vy);
     if (!(h > 1e-6)) continue;
-    const auto ei = static_cast<int>(elevation_bins_.bin(vz, h)) + kElevationBins / 2;
+    int64_t& laser_hint = elevation_hint[index++ % elevation_hint.size()];
+    laser_hint = elevation_bins_.bin(vz, h, laser_hint);
+    const auto ei = static_cast<int>(laser_hint) + kElevationBins / 2;
     if (ei < 0 || ei >= kElevationBins) continue;
-    const int ai = azimuth_bins_.bin(vx, vy);
+    const int ai = azimuth_bins_.bin(vx, vy, azimuth_hint);
+    azimuth_hint = ai;
     float& d = depth_[static_cast<size_t>(ai) * kElevationBins + static_cast<size_t>(ei)];
     const auto range = static_cast<float>(std::hypot(h, vz));
     if (azimuth_seen_[static_cast<size_t>(ai)] == 0) {

@@ -32,14 +32,22 @@ TEST(AngleBins, AzimuthEqualsTheAtan2FormulaEverywhere) {
     const double a = angle(rng);
     const double r = std::pow(10.0, log_length(rng));
     const double x = r * std::cos(a), y = r * std::sin(a);
-    ASSERT_EQ(bins.bin(x, y), bins.bin_by_atan2(x, y)) << x << " " << y;
+    const int exact = bins.bin_by_atan2(x, y);
+    ASSERT_EQ(bins.bin(x, y), exact) << x << " " << y;
+    // With a hint: right, one off, far off, out of range.
+    for (const int hint : {exact, exact + 1, exact - 1, exact + 300, -1, 720}) {
+      ASSERT_EQ(bins.bin(x, y, hint), exact) << x << " " << y << " hint " << hint;
+    }
   }
   // Every boundary, at several lengths, and one ulp around it.
   for (int k = 0; k <= 720; ++k) {
     const double a = -kPi + k * (2.0 * kPi / 720.0);
     for (const double r : {1e-4, 0.37, 1.0, 6.0, 250.0}) {
       with_neighbours(r * std::cos(a), r * std::sin(a), [&](double x, double y) {
-        ASSERT_EQ(bins.bin(x, y), bins.bin_by_atan2(x, y)) << k << " " << x << " " << y;
+        const int exact = bins.bin_by_atan2(x, y);
+        ASSERT_EQ(bins.bin(x, y), exact) << k << " " << x << " " << y;
+        ASSERT_EQ(bins.bin(x, y, k % 720), exact) << k << " " << x << " " << y;
+        ASSERT_EQ(bins.bin(x, y, (k + 719) % 720), exact) << k << " " << x << " " << y;
       });
     }
   }
@@ -59,20 +67,30 @@ TEST(AngleBins, ElevationEqualsTheAtan2FormulaEverywhere) {
     const double a = angle(rng);
     const double r = std::pow(10.0, log_length(rng));
     const double h = r * std::cos(a), z = r * std::sin(a);
-    ASSERT_EQ(bins.bin(z, h), bins.bin_by_atan2(z, h)) << z << " " << h;
+    const int64_t exact = bins.bin_by_atan2(z, h);
+    ASSERT_EQ(bins.bin(z, h), exact) << z << " " << h;
+    for (const int64_t hint : {exact, exact + 1, exact - 1, exact + 40, int64_t{-89}, int64_t{88},
+                               int64_t{200}, int64_t{-200}}) {
+      ASSERT_EQ(bins.bin(z, h, hint), exact) << z << " " << h << " hint " << hint;
+    }
   }
   // Every whole degree from -90 to 90 (the table ends at 89), and one ulp around it.
   for (int k = -90; k <= 90; ++k) {
     const double a = k * (kPi / 180.0);
     for (const double r : {1e-4, 0.8, 9.0}) {
       with_neighbours(r * std::sin(a), r * std::cos(a), [&](double z, double h) {
-        ASSERT_EQ(bins.bin(z, h), bins.bin_by_atan2(z, h)) << k << " " << z << " " << h;
+        const int64_t exact = bins.bin_by_atan2(z, h);
+        ASSERT_EQ(bins.bin(z, h), exact) << k << " " << z << " " << h;
+        ASSERT_EQ(bins.bin(z, h, k), exact) << k << " " << z << " " << h;
+        ASSERT_EQ(bins.bin(z, h, k - 1), exact) << k << " " << z << " " << h;
       });
     }
   }
   for (const double z : {-1.0, -0.0, 0.0, 1.0, 1e6, -1e6}) {
     for (const double h : {-1.0, 0.0, 1e-300, 1.0})
       EXPECT_EQ(bins.bin(z, h), bins.bin_by_atan2(z, h)) << z << " " << h;
+    for (const double h : {-1.0, 0.0, 1e-300, 1.0})
+      EXPECT_EQ(bins.bin(z, h, 0), bins.bin_by_atan2(z, h)) << z << " " << h;
   }
 }
 
