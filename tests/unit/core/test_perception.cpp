@@ -189,6 +189,7 @@ TEST(VoxelGrid, RowsAreTheWindowsColumnsWhereverTheStorageWraps) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-3.9, 3.9);
   std::vector<Ray> rays;
+  rays.reserve(300);
   for (int k = 0; k < 300; ++k)
     rays.push_back(ray_to(u(rng), u(rng), 0.5));
   g.insert(rays, {}, std::nullopt, 1s);
