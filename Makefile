@@ -7,7 +7,7 @@ JOBS ?= $(shell nproc)
 TSAN_TARGETS := test_core_channel test_hal_clock test_firmware_executor test_firmware_daemon \
   test_drivers_amfitrack_threads test_sim_realtime
 FUZZERS := fuzz_candump_line fuzz_slcan_stream fuzz_scout_decode fuzz_amfiprot fuzz_vlp16 \
-  fuzz_pedestrian_dataset
+  fuzz_pedestrian_dataset fuzz_voxel_grid
 FUZZ_SECONDS ?= 10
 
 deps:
@@ -64,7 +64,7 @@ fuzz: deps
 	@set -e; work=$$(mktemp -d); for f in $(FUZZERS); do \
 	  mkdir -p $$work/$$f && cp tests/fuzz/corpus/$$f/* $$work/$$f/; \
 	  echo "== fuzz $$f ($(FUZZ_SECONDS) s) =="; \
-	  build/fuzz/tests/fuzz/$$f -max_total_time=$(FUZZ_SECONDS) -print_final_stats=0 \
+	  build/fuzz/tests/fuzz/$$f -max_total_time=$(FUZZ_SECONDS) -timeout=10 -print_final_stats=0 \
 	    -artifact_prefix=$$work/ $$work/$$f 2>&1 | grep -E "DONE|ERROR|SUMMARY" || true; \
 	  if ls $$work/crash-* $$work/leak-* $$work/timeout-* > /dev/null 2>&1; then \
 	    echo "fuzz $$f: failing input kept in $$work"; exit 1; fi; \
