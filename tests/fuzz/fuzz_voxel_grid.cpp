@@ -61,7 +61,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   constexpr size_t kRayBytes = 11;  // origin x, y; end x, y (int16, lattice); z's; flags
   rays.reserve(size / kRayBytes);
   for (; size >= kRayBytes; data += kRayBytes, size -= kRayBytes) {
-    const double ox = rx + read_i16(data) * kLatticeM / 16.0;  // the sensor: within 2.5 cm
+    const double ox = rx + read_i16(data) * kLatticeM / 16.0;  // the sensor: within 1.6 m
     const double oy = ry + read_i16(data + 2) * kLatticeM / 16.0;
     const double ex = rx + read_i16(data + 4) * kLatticeM;  // within +-25 m
     const double ey = ry + read_i16(data + 6) * kLatticeM;

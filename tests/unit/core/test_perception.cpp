@@ -211,9 +211,7 @@ TEST(VoxelGrid, RowsAreTheWindowsColumnsWhereverTheStorageWraps) {
 // leaving for ever: the lidar task hung. It crosses the face and clears on the other side (in
 // exact arithmetic it is over the face after 4e-7 of its length).
 TEST(VoxelGrid, ARayAlongABlockFaceEndsAndClearsBeyondTheFace) {
-  core::VoxelGridConfig c;
-  c.size_xy_m = 12.0;
-  c.resolution_m = 0.05;
+  core::VoxelGridConfig c;  // the defaults: 12 m at 5 cm
   c.clear_seen_through = false;
   core::VoxelGrid g(c);
   g.recentre(0.0, 0.0);
@@ -234,12 +232,7 @@ TEST(VoxelGrid, ARayAlongABlockFaceEndsAndClearsBeyondTheFace) {
 // odd offsets, near odom's origin and kilometres from it) and the walk's hard cases (rays along
 // block faces, through block corners, nearly parallel to an axis).
 TEST(VoxelGrid, TheWalkOverEmptyBlocksClearsExactlyWhatTheGeneralEntryDoes) {
-  core::VoxelGridConfig c;
-  c.size_xy_m = 12.0;
-  c.resolution_m = 0.05;
-  c.z_min_m = 0.05;
-  c.z_max_m = 2.0;
-  c.clear_max_range_m = 10.0;
+  core::VoxelGridConfig c;       // the defaults: 12 m at 5 cm, 0.05-2.0 m, clearing to 10 m
   c.clear_seen_through = false;  // ray clearing alone
   std::mt19937_64 rng(17);
   std::uniform_real_distribution<double> u(-1.0, 1.0);

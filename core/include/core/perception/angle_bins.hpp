@@ -21,7 +21,6 @@ class AzimuthBins {
   [[nodiscard]] int bin(double x, double y, int hint) const;
   // The formula with std::atan2: the reference, and the path near a boundary.
   [[nodiscard]] int bin_by_atan2(double x, double y) const;
-  [[nodiscard]] int bins() const { return bins_; }
 
  private:
   // Side of (x, y) against boundary k (counter-clockwise positive), or 0 when it is within the
@@ -42,7 +41,6 @@ class ElevationBins {
   [[nodiscard]] int64_t bin(double z, double h) const;
   [[nodiscard]] int64_t bin(double z, double h, int64_t hint) const;  // as AzimuthBins's
   [[nodiscard]] int64_t bin_by_atan2(double z, double h) const;
-  [[nodiscard]] double width_rad() const { return width_rad_; }
 
  private:
   double width_rad_;

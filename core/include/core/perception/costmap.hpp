@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/perception/voxel_grid.hpp"
+#include "core/util/floor_to_int.hpp"
 
 namespace core {
 
@@ -110,11 +111,9 @@ class Costmap {
     return (1 - fx) * (1 - fy) * cell(i, j) + fx * (1 - fy) * cell(i + 1, j) +
            (1 - fx) * fy * cell(i, j + 1) + fx * fy * cell(i + 1, j + 1);
   }
-  // floor() without the libm call (the controller looks the costmap up 200 000 times per step).
-  static int floor_int(double v) {
-    const auto i = static_cast<int>(v);
-    return i - static_cast<int>(v < static_cast<double>(i));
-  }
+  // floor() without the libm call (the controller looks the costmap up 200 000 times per step);
+  // callers keep |v| < 1e9.
+  static int floor_int(double v) { return static_cast<int>(floor_to_int(v)); }
 
   // The least and greatest cost of the four cells of the quad whose lower corner is cell (i, j),
   // i, j in -1 .. n - 1 (cells off the map count as lethal, as cell() has them).
