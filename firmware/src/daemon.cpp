@@ -135,6 +135,7 @@ core::InteractiveSpaceConfig interactive_space_config(const DaemonConfig& cfg) {
   c.gamma = cfg.objective.gamma;
   c.delta = cfg.objective.delta;
   c.switch_cost = cfg.objective.switch_cost;
+  c.turn_inside = cfg.objective.turn_inside;
   c.speed_standoff = cfg.interactive_space.speed_standoff;
   c.speed_standoff_max_m = cfg.interactive_space.speed_standoff_max_m;
   c.speed_standoff_filter_s = cfg.interactive_space.speed_standoff_filter_s;
@@ -242,6 +243,7 @@ Daemon::Daemon(const DaemonConfig& cfg, hal::SystemdNotifier& notifier)
                 : cfg.policy.selector == "fixed_side"   ? Selector::kFixedSide
                                                         : Selector::kAuto),
       standoff_velocity_(space_.config()),
+      goal_slew_(cfg.objective.slew_points_per_s),
       goal_hold_(core::from_ms(std::llround(cfg.policy.hold_last_point_ms))),
       mppi_(mppi_config(cfg)),
       pid_(pid_follower_config(cfg)),
@@ -479,7 +481,7 @@ void Daemon::policy_task(const core::Tick& tick) {
                           th ? th->value.confidence : core::TrackerConfidence::kUnknown);
     const core::Point2 velocity_base =
         standoff_velocity_.base(h.velocity_odom, h.velocity_base, robot_odom, tick.now);
-    space_.update(h.pose_base, robot_odom, *map, velocity_base);
+    space_.update(h.pose_base, robot_odom, *map, velocity_base, h.yaw_rate_radps);
     core::Selection s = core::select_by_objective(space_, goal_hold_.index());
     if (selector_ == Selector::kFixedBehind || selector_ == Selector::kFixedSide) {
       // Evaluation baselines: one point of W, free or not (phi = pi behind, pi/2 the left side).
@@ -515,6 +517,9 @@ void Daemon::policy_task(const core::Tick& tick) {
           g.selector = "policy";
         }
       }
+    }
+    if (std::string_view(g.selector) == "objective") {
+      s = goal_slew_.update(s, goal_hold_.index(), space_, tick.period);
     }
     s = goal_hold_.update(s, space_, tick.now);
     g.held = goal_hold_.held();

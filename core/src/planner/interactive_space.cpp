@@ -35,7 +35,8 @@ InteractiveSpace::InteractiveSpace(const InteractiveSpaceConfig& config)
 }
 
 void InteractiveSpace::update(const Pose2& person_base, const Pose2& robot_odom,
-                              const Costmap& costmap, const Point2& person_velocity_base) {
+                              const Costmap& costmap, const Point2& person_velocity_base,
+                              double person_yaw_rate_radps) {
   free_count_ = 0;
   // The person's velocity in their own frame: a robot at a point of W faces their heading, so
   // its axes are theirs (only the standoff reads it).
@@ -68,8 +69,10 @@ void InteractiveSpace::update(const Pose2& person_base, const Pose2& robot_odom,
     c.odom = robot_odom.apply(p);
     c.cost = costmap.at(c.odom.x_m, c.odom.y_m);
     const double ahead_of_person_m = std::max(0.0, config_.a_m * cos_phi_[i]);
+    const double inside_of_turn = std::max(0.0, person_yaw_rate_radps * config_.b_m * sin_phi_[i]);
     c.objective = config_.alpha * c.dist_human_m + config_.beta * c.dist_robot_m +
-                  config_.gamma * c.cost + config_.delta * ahead_of_person_m;
+                  config_.gamma * c.cost + config_.delta * ahead_of_person_m +
+                  config_.turn_inside * inside_of_turn;
     c.free = c.cost < config_.cost_threshold;
     free_count_ += c.free ? 1U : 0U;
   }

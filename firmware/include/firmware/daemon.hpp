@@ -20,6 +20,7 @@
 #include "core/human/human_ekf.hpp"
 #include "core/perception/costmap.hpp"
 #include "core/planner/goal_hold.hpp"
+#include "core/planner/goal_slew.hpp"
 #include "core/planner/interactive_space.hpp"
 #include "core/planner/standoff_velocity.hpp"
 #include "core/policy/mlp_policy.hpp"
@@ -276,6 +277,7 @@ class Daemon {  // NOLINT(clang-analyzer-optin.performance.Padding)
   std::vector<float> observation_;
   // The person's velocity for interactive_space.speed_standoff; reset while there is no person.
   core::StandoffVelocity standoff_velocity_;
+  core::GoalSlew goal_slew_;  // objective.slew_points_per_s
   core::GoalHold goal_hold_;  // policy.hold_last_point_ms; its index is the previous action
   core::LatestValue<CompanionGoal> goal_;
 

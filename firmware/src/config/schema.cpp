@@ -784,6 +784,27 @@ std::vector<FieldSpec> build() {
        0.0,
        1000.0,
        {}},
+      {"objective.turn_inside",
+       "s/(rad m)",
+       "turn_inside: G of a candidate plus turn_inside * max(0, omega * y), omega the person's "
+       "estimated turn rate (+ left), y how far the candidate is to their left (b sin phi_i): the "
+       "inside of a sharp turn, where the turning person walks, costs more. Ours; 0: the paper's "
+       "G (an experiment: docs/EVALUATION.md, thirty-second session).",
+       FIELD(objective.turn_inside),
+       0.0,
+       1000.0,
+       {}},
+      {"objective.slew_points_per_s",
+       "1/s",
+       "slew_points_per_s: the objective's q^d steps toward the argmin along W, through free "
+       "points only, at most this many points a second (ours; the paper's learned selector is "
+       "trained for this with its action-smoothness reward r^a). 0: off, the argmin at once. "
+       "Where neither way round W is free the argmin is taken at once (an experiment: "
+       "docs/EVALUATION.md, thirty-second session).",
+       FIELD(objective.slew_points_per_s),
+       0.0,
+       10000.0,
+       {}},
       {"mppi.horizon_steps",
        "count",
        "K: prediction steps (paper: 100).",

@@ -8,6 +8,7 @@
 #include "core/perception/costmap.hpp"
 #include "core/perception/voxel_grid.hpp"
 #include "core/planner/goal_hold.hpp"
+#include "core/planner/goal_slew.hpp"
 #include "core/planner/interactive_space.hpp"
 
 using std::numbers::pi;
@@ -352,3 +353,121 @@ TEST(InteractiveSpace, SpeedStandoffStopsAtItsCap) {
 }
 
 }  // namespace
+
+// A costmap of an empty 8 m room with walls along y = each of `wall_ys` (odom), 0.5 m high.
+core::Costmap walled_room(std::initializer_list<double> wall_ys) {
+  core::VoxelGridConfig gc;
+  gc.size_xy_m = 8.0;
+  core::VoxelGrid g(gc);
+  g.recentre(0, 0);
+  std::vector<core::Ray> rays;
+  for (const double y : wall_ys) {
+    for (double x = -3.9; x <= 3.9; x += 0.02)
+      rays.push_back({{0.0, 0.0, 3.0}, {x, y, 0.5}});
+  }
+  g.insert(rays, core::Pose2{20, 20, 0}, std::nullopt, 1s);
+  core::Costmap m;
+  m.build(g, core::CostmapConfig{}, 1s);
+  return m;
+}
+
+core::Selection choice_of(const core::InteractiveSpace& w, int index) {
+  return core::Selection{core::GoalStatus::kOk, index,
+                         w.candidates()[static_cast<size_t>(index)].base};
+}
+
+// The person 2 m ahead of the robot, walking along +x: 64 points, 0 ahead of them, 16 on their
+// left, 32 behind, 48 on their right.
+const core::Pose2 kPersonAhead{2.0, 0.0, 0.0};
+
+TEST(GoalSlew, StepsRoundTheEllipseAtTheRateThenHoldsTheArgmin) {
+  core::InteractiveSpace w(core::InteractiveSpaceConfig{});
+  w.update(kPersonAhead, core::Pose2{}, walled_room({}));
+  // From the left-hand point to the right-hand one, 32 steps either way: at 30 points a second
+  // and one update per 1/30 s, one step an update; each point on the way is q^d in turn.
+  core::GoalSlew slew(30.0);
+  int from = 16;
+  for (int k = 1; k <= 32; ++k) {
+    const core::Selection s = slew.update(choice_of(w, 48), from, w, 33'333'334ns);
+    ASSERT_EQ(s.status, core::GoalStatus::kOk);
+    ASSERT_EQ(s.index, 16 + k) << "update " << k;
+    EXPECT_EQ(s.goal_base.x_m, w.candidates()[static_cast<size_t>(s.index)].base.x_m);
+    EXPECT_EQ(s.goal_base.y_m, w.candidates()[static_cast<size_t>(s.index)].base.y_m);
+    from = s.index;
+  }
+  EXPECT_EQ(from, 48);
+  EXPECT_EQ(slew.update(choice_of(w, 48), from, w, 33'333'334ns).index, 48) << "arrived";
+  // 25 points a second in 100 ms updates: 2.5 points each, the fraction carried over.
+  core::GoalSlew quarter(25.0);
+  from = 48;
+  for (int k = 0; k < 4; ++k)
+    from = quarter.update(choice_of(w, 16), from, w, 100ms).index;
+  EXPECT_EQ(from, 58) << "10 steps on round the front toward the left in 400 ms";
+  // Off, or nothing in use yet: the argmin at once.
+  EXPECT_EQ(core::GoalSlew(0.0).update(choice_of(w, 48), 16, w, 1s).index, 48);
+  EXPECT_EQ(core::GoalSlew(30.0).update(choice_of(w, 48), -1, w, 1s).index, 48);
+}
+
+TEST(GoalSlew, GoesOnlyThroughFreePointsAndJumpsWhereNeitherWayIsFree) {
+  // A wall 0.9 m left of the person closes the points on their left.
+  core::InteractiveSpace w(core::InteractiveSpaceConfig{});
+  w.update(kPersonAhead, core::Pose2{}, walled_room({0.9}));
+  const auto c = w.candidates();
+  ASSERT_FALSE(c[16].free);
+  ASSERT_TRUE(c[0].free);
+  ASSERT_TRUE(c[32].free);
+  ASSERT_TRUE(c[48].free);
+  // From ahead to behind: 32 steps either way, and the way past the left is closed: it goes
+  // round the right (63, 62, ...), although the tie would go left.
+  core::GoalSlew slew(30.0);
+  EXPECT_EQ(slew.update(choice_of(w, 32), 0, w, 33'333'334ns).index, 63);
+  // From a closed point it leaves at once, however slow the rate: the first closed point going
+  // left from ahead, with its free neighbour toward the right.
+  int edge = 1;
+  while (c[static_cast<size_t>(edge)].free)
+    ++edge;
+  ASSERT_LT(edge, 16);
+  core::GoalSlew slow(1.0);
+  EXPECT_EQ(slow.update(choice_of(w, 32), edge, w, 10ms).index, edge - 1);
+  // From a free point at that rate it waits for the step it is owed (the argmin stays ahead).
+  EXPECT_EQ(slow.update(choice_of(w, 32), 0, w, 10ms).index, 0);
+  // Walls on both sides: neither way round from ahead to behind is free; the argmin at once.
+  core::InteractiveSpace both(core::InteractiveSpaceConfig{});
+  both.update(kPersonAhead, core::Pose2{}, walled_room({0.9, -0.9}));
+  ASSERT_FALSE(both.candidates()[16].free);
+  ASSERT_FALSE(both.candidates()[48].free);
+  ASSERT_TRUE(both.candidates()[0].free);
+  ASSERT_TRUE(both.candidates()[32].free);
+  EXPECT_EQ(core::GoalSlew(30.0).update(choice_of(both, 32), 0, both, 33'333'334ns).index, 32);
+}
+
+TEST(InteractiveSpace, TurnInsideRaisesGOnTheSideThePersonTurnsToInProportion) {
+  // The person 2 m ahead walking along +x, turning left at 1.5 rad/s: the points on their left
+  // (y^h = b sin phi > 0) cost turn_inside * 1.5 * y^h more, those on the right nothing more.
+  core::InteractiveSpaceConfig cfg;
+  ASSERT_DOUBLE_EQ(cfg.turn_inside, 0.0) << "the paper's G by default";
+  const core::Costmap open = walled_room({});
+  core::InteractiveSpace paper(cfg);
+  paper.update(kPersonAhead, core::Pose2{}, open, {}, 1.5);
+  cfg.turn_inside = 4.0;
+  core::InteractiveSpace turning(cfg);
+  turning.update(kPersonAhead, core::Pose2{}, open, {}, 1.5);
+  core::InteractiveSpace straight(cfg);
+  straight.update(kPersonAhead, core::Pose2{}, open, {}, 0.0);
+  for (size_t i = 0; i < 64; ++i) {
+    const double y_h = turning.point_in_person(i).y_m;
+    EXPECT_NEAR(turning.candidates()[i].objective - paper.candidates()[i].objective,
+                4.0 * 1.5 * std::max(0.0, y_h), 1e-9)
+        << i;
+    EXPECT_DOUBLE_EQ(straight.candidates()[i].objective, paper.candidates()[i].objective) << i;
+  }
+  EXPECT_NEAR(turning.candidates()[16].objective - paper.candidates()[16].objective,
+              4.0 * 1.5 * 0.7, 1e-9)
+      << "the left-hand point: b = 0.7 m to the left";
+  // Turning right instead: the right-hand side pays.
+  core::InteractiveSpace right(cfg);
+  right.update(kPersonAhead, core::Pose2{}, open, {}, -1.5);
+  EXPECT_NEAR(right.candidates()[48].objective - paper.candidates()[48].objective, 4.0 * 1.5 * 0.7,
+              1e-9);
+  EXPECT_DOUBLE_EQ(right.candidates()[16].objective, paper.candidates()[16].objective);
+}

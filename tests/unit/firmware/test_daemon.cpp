@@ -665,6 +665,94 @@ TEST(DaemonWithTrackerAndLidar, TheSwitchCostCountsFromThePointChosenLast) {
   EXPECT_EQ(kept[1], kept[0]) << "kept: switching costs more than any difference in G";
 }
 
+TEST(DaemonWithTrackerAndLidar, TheSlewStepsTheObjectivesPointRoundTheEllipse) {
+  // As above: at 1 s the person moves to the robot's other side and G's argmin to the mirror
+  // point. Without objective.slew_points_per_s the goal jumps there at once; with 30 points a
+  // second (the policy task's 30 Hz: a point an update) it steps there one point at a time.
+  const auto goals = [](double slew_points_per_s) {
+    firmware::DaemonConfig config = defaults();
+    config.objective.slew_points_per_s = slew_points_per_s;
+    auto opened = hal::UdpReceiver::open({"127.0.0.1", 0}, 4 << 20, hal::UdpStamp::kDrain);
+    EXPECT_TRUE(opened.receiver) << opened.error;
+    RoundRoom room(opened.receiver->port());
+    std::vector<std::pair<int, Nanos>> seen;  // each new goal's index and stamp from 950 ms on
+    Nanos last_stamp{-1};
+    DaemonWithBase d(
+        [&](Nanos now, DaemonWithBase& w) {
+          if (now == 0ms) person_ahead(w.tracker);
+          if (now == 1000ms) w.tracker.set_sensor_pose(-1.2, -0.3, 0.0, std::numbers::pi);
+          room.step(now);
+          const auto g = w.daemon.goal().read();
+          if (now >= 950ms && g && g->stamp != last_stamp &&
+              g->value.status == core::GoalStatus::kOk) {
+            seen.emplace_back(g->value.index, g->stamp);
+            last_stamp = g->stamp;
+          }
+        },
+        true, config);
+    d.daemon.attach_lidar(std::move(opened.receiver));
+    d.run_until(2500ms);
+    return seen;
+  };
+  const auto wrapped = [](int a, int b) {
+    const int k = std::abs(a - b) % 64;
+    return std::min(k, 64 - k);
+  };
+  const auto jump = goals(0.0);
+  ASSERT_GE(jump.size(), 30U);
+  const int before = jump.front().first;
+  const int after = jump.back().first;
+  ASSERT_GE(wrapped(before, after), 4) << "the argmin moves by several points";
+  int largest = 0;
+  for (size_t k = 1; k < jump.size(); ++k)
+    largest = std::max(largest, wrapped(jump[k - 1].first, jump[k].first));
+  EXPECT_GE(largest, 4) << "without the slew: at once";
+  const auto slewed = goals(30.0);
+  ASSERT_GE(slewed.size(), 30U);
+  EXPECT_EQ(slewed.front().first, before);
+  EXPECT_EQ(slewed.back().first, after) << "it gets there";
+  for (size_t k = 1; k < slewed.size(); ++k) {
+    // The world step that reads the goal may see every second update: a point per update.
+    const auto updates =
+        std::llround(core::to_seconds(slewed[k].second - slewed[k - 1].second) * 30);
+    EXPECT_LE(wrapped(slewed[k - 1].first, slewed[k].first), updates) << "goal " << k;
+  }
+}
+
+TEST(DaemonWithTrackerAndLidar, TurnInsideKeepsThePointOffTheSideThePersonTurnsTo) {
+  // The person 1.2 m ahead and 0.3 m right, turning left on the spot at 1 rad/s from 0.5 s: the
+  // robot is behind them and to their left, where G's argmin is. With objective.turn_inside the
+  // daemon passes the person's estimated turn rate to W, and a large weight moves q^d off their
+  // left (the inside of the turn).
+  const auto index_at_1s = [](double turn_inside) {
+    firmware::DaemonConfig config = defaults();
+    config.objective.turn_inside = turn_inside;
+    auto opened = hal::UdpReceiver::open({"127.0.0.1", 0}, 4 << 20, hal::UdpStamp::kDrain);
+    EXPECT_TRUE(opened.receiver) << opened.error;
+    RoundRoom room(opened.receiver->port());
+    int seen = -1;
+    DaemonWithBase d(
+        [&](Nanos now, DaemonWithBase& w) {
+          const double heading = now > 500ms ? core::to_seconds(now - 500ms) * 1.0 : 0.0;
+          w.tracker.set_sensor_pose(-1.2, 0.3, 0.0, std::numbers::pi + heading);
+          room.step(now);
+          const auto g = w.daemon.goal().read();
+          if (now == 1000ms && g && g->value.status == core::GoalStatus::kOk) {
+            seen = g->value.index;
+          }
+        },
+        true, config);
+    d.daemon.attach_lidar(std::move(opened.receiver));
+    d.run_until(1000ms);
+    return seen;
+  };
+  const int paper = index_at_1s(0.0);
+  EXPECT_GT(paper, 16) << "behind-left: toward the robot";
+  EXPECT_LT(paper, 32);
+  const int turning = index_at_1s(1000.0);
+  EXPECT_TRUE(turning == 0 || turning >= 32) << turning << ": not on the person's left";
+}
+
 TEST(Daemon, SideOfPersonNamesTheDesignPointsAngle) {
   EXPECT_STREQ(firmware::side_of_person(0, 64), "front");
   EXPECT_STREQ(firmware::side_of_person(16, 64), "left");

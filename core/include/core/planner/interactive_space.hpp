@@ -34,6 +34,11 @@ struct InteractiveSpaceConfig {
   // paper's action-smoothness reward r^a = -sigma_a |a_t - a_(t-1)| as a cost: on a near tie
   // q^d stays where it is rather than jumping round the person. 0: the paper's G.
   double switch_cost = 0.0;
+  // Ours: G of a point plus turn_inside * max(0, omega * y^h_i), omega the person's turn rate
+  // (rad/s, + left), y^h_i = b sin phi_i how far the point is to their left: the points on the
+  // inside of a turn cost more the sharper it is. A robot there is where the turning person
+  // walks (docs/EVALUATION.md, twenty-fifth and thirtieth sessions). 0: the paper's G.
+  double turn_inside = 0.0;
   // Ours: when true, a point of W nearer the person than the robot may follow them under the
   // closing-speed limit (follow_standoff_m with `closing`, at the person's velocity) is moved
   // out along its ray to that distance: its cost, whether it is free, and q^d are taken there;
@@ -66,9 +71,10 @@ class InteractiveSpace {
   explicit InteractiveSpace(const InteractiveSpaceConfig& config);
 
   // W and P for the person (base_link) seen from the robot (its pose in odom, for the costmap);
-  // `person_velocity_base`: their velocity in base_link axes (used by speed_standoff only).
+  // `person_velocity_base`: their velocity in base_link axes (used by speed_standoff only);
+  // `person_yaw_rate_radps`: their turn rate (used by turn_inside only).
   void update(const Pose2& person_base, const Pose2& robot_odom, const Costmap& costmap,
-              const Point2& person_velocity_base = {});
+              const Point2& person_velocity_base = {}, double person_yaw_rate_radps = 0.0);
 
   [[nodiscard]] std::span<const Candidate> candidates() const { return candidates_; }
   [[nodiscard]] size_t free_count() const { return free_count_; }

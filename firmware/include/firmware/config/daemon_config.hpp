@@ -123,6 +123,8 @@ struct DaemonConfig {
     double gamma = 0;
     double delta = 0;
     double switch_cost = 0;
+    double slew_points_per_s = 0;
+    double turn_inside = 0;
   } objective;
 
   struct Policy {
