@@ -16,23 +16,27 @@ using namespace std::chrono_literals;
 
 namespace {
 
-// A costmap of an empty 8 m room, or with a wall along y = wall_y (odom), 0.5 m high.
-core::Costmap room(std::optional<double> wall_y) {
+// A costmap of an empty 8 m room with walls along y = each of `wall_ys` (odom), 0.5 m high.
+core::Costmap walled_room(std::initializer_list<double> wall_ys) {
   core::VoxelGridConfig gc;
   gc.size_xy_m = 8.0;
   gc.resolution_m = 0.05;
   core::VoxelGrid g(gc);
   g.recentre(0, 0);
   std::vector<core::Ray> rays;
-  if (wall_y) {
-    for (double x = -3.9; x <= 3.9; x += 0.02) {
-      rays.push_back({{0.0, 0.0, 3.0}, {x, *wall_y, 0.5}});
-    }
+  for (const double y : wall_ys) {
+    for (int k = 0; k <= 390; ++k)  // x from -3.9 to 3.9 m every 2 cm
+      rays.push_back({{0.0, 0.0, 3.0}, {-3.9 + 0.02 * k, y, 0.5}});
   }
   g.insert(rays, core::Pose2{20, 20, 0}, std::nullopt, 1s);
   core::Costmap m;
   m.build(g, core::CostmapConfig{}, 1s);
   return m;
+}
+
+// An empty 8 m room, or one with a wall along y = wall_y.
+core::Costmap room(std::optional<double> wall_y) {
+  return wall_y ? walled_room({*wall_y}) : walled_room({});
 }
 
 TEST(InteractiveSpace, PointsLieOnTheEllipseAroundThePersonInBaseLink) {
@@ -354,23 +358,6 @@ TEST(InteractiveSpace, SpeedStandoffStopsAtItsCap) {
 
 }  // namespace
 
-// A costmap of an empty 8 m room with walls along y = each of `wall_ys` (odom), 0.5 m high.
-core::Costmap walled_room(std::initializer_list<double> wall_ys) {
-  core::VoxelGridConfig gc;
-  gc.size_xy_m = 8.0;
-  core::VoxelGrid g(gc);
-  g.recentre(0, 0);
-  std::vector<core::Ray> rays;
-  for (const double y : wall_ys) {
-    for (double x = -3.9; x <= 3.9; x += 0.02)
-      rays.push_back({{0.0, 0.0, 3.0}, {x, y, 0.5}});
-  }
-  g.insert(rays, core::Pose2{20, 20, 0}, std::nullopt, 1s);
-  core::Costmap m;
-  m.build(g, core::CostmapConfig{}, 1s);
-  return m;
-}
-
 core::Selection choice_of(const core::InteractiveSpace& w, int index) {
   return core::Selection{core::GoalStatus::kOk, index,
                          w.candidates()[static_cast<size_t>(index)].base};
@@ -378,11 +365,13 @@ core::Selection choice_of(const core::InteractiveSpace& w, int index) {
 
 // The person 2 m ahead of the robot, walking along +x: 64 points, 0 ahead of them, 16 on their
 // left, 32 behind, 48 on their right.
-const core::Pose2 kPersonAhead{2.0, 0.0, 0.0};
+core::Pose2 person_ahead() {
+  return core::Pose2{2.0, 0.0, 0.0};
+}
 
 TEST(GoalSlew, StepsRoundTheEllipseAtTheRateThenHoldsTheArgmin) {
   core::InteractiveSpace w(core::InteractiveSpaceConfig{});
-  w.update(kPersonAhead, core::Pose2{}, walled_room({}));
+  w.update(person_ahead(), core::Pose2{}, walled_room({}));
   // From the left-hand point to the right-hand one, 32 steps either way: at 30 points a second
   // and one update per 1/30 s, one step an update; each point on the way is q^d in turn.
   core::GoalSlew slew(30.0);
@@ -411,7 +400,7 @@ TEST(GoalSlew, StepsRoundTheEllipseAtTheRateThenHoldsTheArgmin) {
 TEST(GoalSlew, GoesOnlyThroughFreePointsAndJumpsWhereNeitherWayIsFree) {
   // A wall 0.9 m left of the person closes the points on their left.
   core::InteractiveSpace w(core::InteractiveSpaceConfig{});
-  w.update(kPersonAhead, core::Pose2{}, walled_room({0.9}));
+  w.update(person_ahead(), core::Pose2{}, walled_room({0.9}));
   const auto c = w.candidates();
   ASSERT_FALSE(c[16].free);
   ASSERT_TRUE(c[0].free);
@@ -433,7 +422,7 @@ TEST(GoalSlew, GoesOnlyThroughFreePointsAndJumpsWhereNeitherWayIsFree) {
   EXPECT_EQ(slow.update(choice_of(w, 32), 0, w, 10ms).index, 0);
   // Walls on both sides: neither way round from ahead to behind is free; the argmin at once.
   core::InteractiveSpace both(core::InteractiveSpaceConfig{});
-  both.update(kPersonAhead, core::Pose2{}, walled_room({0.9, -0.9}));
+  both.update(person_ahead(), core::Pose2{}, walled_room({0.9, -0.9}));
   ASSERT_FALSE(both.candidates()[16].free);
   ASSERT_FALSE(both.candidates()[48].free);
   ASSERT_TRUE(both.candidates()[0].free);
@@ -448,12 +437,12 @@ TEST(InteractiveSpace, TurnInsideRaisesGOnTheSideThePersonTurnsToInProportion) {
   ASSERT_DOUBLE_EQ(cfg.turn_inside, 0.0) << "the paper's G by default";
   const core::Costmap open = walled_room({});
   core::InteractiveSpace paper(cfg);
-  paper.update(kPersonAhead, core::Pose2{}, open, {}, 1.5);
+  paper.update(person_ahead(), core::Pose2{}, open, {}, 1.5);
   cfg.turn_inside = 4.0;
   core::InteractiveSpace turning(cfg);
-  turning.update(kPersonAhead, core::Pose2{}, open, {}, 1.5);
+  turning.update(person_ahead(), core::Pose2{}, open, {}, 1.5);
   core::InteractiveSpace straight(cfg);
-  straight.update(kPersonAhead, core::Pose2{}, open, {}, 0.0);
+  straight.update(person_ahead(), core::Pose2{}, open, {}, 0.0);
   for (size_t i = 0; i < 64; ++i) {
     const double y_h = turning.point_in_person(i).y_m;
     EXPECT_NEAR(turning.candidates()[i].objective - paper.candidates()[i].objective,
@@ -466,7 +455,7 @@ TEST(InteractiveSpace, TurnInsideRaisesGOnTheSideThePersonTurnsToInProportion) {
       << "the left-hand point: b = 0.7 m to the left";
   // Turning right instead: the right-hand side pays.
   core::InteractiveSpace right(cfg);
-  right.update(kPersonAhead, core::Pose2{}, open, {}, -1.5);
+  right.update(person_ahead(), core::Pose2{}, open, {}, -1.5);
   EXPECT_NEAR(right.candidates()[48].objective - paper.candidates()[48].objective, 4.0 * 1.5 * 0.7,
               1e-9);
   EXPECT_DOUBLE_EQ(right.candidates()[16].objective, paper.candidates()[16].objective);
