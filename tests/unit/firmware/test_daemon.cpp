@@ -630,6 +630,25 @@ TEST(DaemonWithTrackerAndLidar, ChoosesACompanionPointAroundThePerson) {
       << d.daemon.status_line();
 }
 
+namespace {
+// The daemon (tracker, base and the round room's lidar) with `config` until `until`; `each` runs
+// at every world step, before the room's (it sets the person's pose and reads the goal).
+void run_in_round_room(const firmware::DaemonConfig& config, Nanos until,
+                       const std::function<void(Nanos, DaemonWithBase&)>& each) {
+  auto opened = hal::UdpReceiver::open({"127.0.0.1", 0}, 4 << 20, hal::UdpStamp::kDrain);
+  ASSERT_TRUE(opened.receiver) << opened.error;
+  RoundRoom room(opened.receiver->port());
+  DaemonWithBase d(
+      [&](Nanos now, DaemonWithBase& w) {
+        each(now, w);
+        room.step(now);
+      },
+      true, config);
+  d.daemon.attach_lidar(std::move(opened.receiver));
+  d.run_until(until);
+}
+}  // namespace
+
 TEST(DaemonWithTrackerAndLidar, TheSwitchCostCountsFromThePointChosenLast) {
   // The person 1.2 m ahead and 0.3 m right, then (at 1 s) 0.3 m left: G's argmin moves to the
   // mirror point. With objective.switch_cost the daemon passes the point it chose last to the
@@ -637,23 +656,15 @@ TEST(DaemonWithTrackerAndLidar, TheSwitchCostCountsFromThePointChosenLast) {
   const auto indices = [](double switch_cost) {
     firmware::DaemonConfig config = defaults();
     config.objective.switch_cost = switch_cost;
-    auto opened = hal::UdpReceiver::open({"127.0.0.1", 0}, 4 << 20, hal::UdpStamp::kDrain);
-    EXPECT_TRUE(opened.receiver) << opened.error;
-    RoundRoom room(opened.receiver->port());
     std::array<int, 2> seen{-1, -1};
-    DaemonWithBase d(
-        [&](Nanos now, DaemonWithBase& w) {
-          if (now == 0ms) person_ahead(w.tracker);
-          if (now == 1000ms) w.tracker.set_sensor_pose(-1.2, -0.3, 0.0, std::numbers::pi);
-          room.step(now);
-          const auto g = w.daemon.goal().read();
-          const bool ok = g && g->value.status == core::GoalStatus::kOk;
-          if (now == 950ms && ok) seen[0] = g->value.index;
-          if (now == 1500ms && ok) seen[1] = g->value.index;
-        },
-        true, config);
-    d.daemon.attach_lidar(std::move(opened.receiver));
-    d.run_until(1500ms);
+    run_in_round_room(config, 1500ms, [&](Nanos now, DaemonWithBase& w) {
+      if (now == 0ms) person_ahead(w.tracker);
+      if (now == 1000ms) w.tracker.set_sensor_pose(-1.2, -0.3, 0.0, std::numbers::pi);
+      const auto g = w.daemon.goal().read();
+      const bool ok = g && g->value.status == core::GoalStatus::kOk;
+      if (now == 950ms && ok) seen[0] = g->value.index;
+      if (now == 1500ms && ok) seen[1] = g->value.index;
+    });
     return seen;
   };
   const auto paper = indices(0.0);
@@ -672,26 +683,17 @@ TEST(DaemonWithTrackerAndLidar, TheSlewStepsTheObjectivesPointRoundTheEllipse) {
   const auto goals = [](double slew_points_per_s) {
     firmware::DaemonConfig config = defaults();
     config.objective.slew_points_per_s = slew_points_per_s;
-    auto opened = hal::UdpReceiver::open({"127.0.0.1", 0}, 4 << 20, hal::UdpStamp::kDrain);
-    EXPECT_TRUE(opened.receiver) << opened.error;
-    RoundRoom room(opened.receiver->port());
     std::vector<std::pair<int, Nanos>> seen;  // each new goal's index and stamp from 950 ms on
     Nanos last_stamp{-1};
-    DaemonWithBase d(
-        [&](Nanos now, DaemonWithBase& w) {
-          if (now == 0ms) person_ahead(w.tracker);
-          if (now == 1000ms) w.tracker.set_sensor_pose(-1.2, -0.3, 0.0, std::numbers::pi);
-          room.step(now);
-          const auto g = w.daemon.goal().read();
-          if (now >= 950ms && g && g->stamp != last_stamp &&
-              g->value.status == core::GoalStatus::kOk) {
-            seen.emplace_back(g->value.index, g->stamp);
-            last_stamp = g->stamp;
-          }
-        },
-        true, config);
-    d.daemon.attach_lidar(std::move(opened.receiver));
-    d.run_until(2500ms);
+    run_in_round_room(config, 2500ms, [&](Nanos now, DaemonWithBase& w) {
+      if (now == 0ms) person_ahead(w.tracker);
+      if (now == 1000ms) w.tracker.set_sensor_pose(-1.2, -0.3, 0.0, std::numbers::pi);
+      const auto g = w.daemon.goal().read();
+      if (now >= 950ms && g && g->stamp != last_stamp && g->value.status == core::GoalStatus::kOk) {
+        seen.emplace_back(g->value.index, g->stamp);
+        last_stamp = g->stamp;
+      }
+    });
     return seen;
   };
   const auto wrapped = [](int a, int b) {
@@ -727,23 +729,13 @@ TEST(DaemonWithTrackerAndLidar, TurnInsideKeepsThePointOffTheSideThePersonTurnsT
   const auto index_at_1s = [](double turn_inside) {
     firmware::DaemonConfig config = defaults();
     config.objective.turn_inside = turn_inside;
-    auto opened = hal::UdpReceiver::open({"127.0.0.1", 0}, 4 << 20, hal::UdpStamp::kDrain);
-    EXPECT_TRUE(opened.receiver) << opened.error;
-    RoundRoom room(opened.receiver->port());
     int seen = -1;
-    DaemonWithBase d(
-        [&](Nanos now, DaemonWithBase& w) {
-          const double heading = now > 500ms ? core::to_seconds(now - 500ms) * 1.0 : 0.0;
-          w.tracker.set_sensor_pose(-1.2, 0.3, 0.0, std::numbers::pi + heading);
-          room.step(now);
-          const auto g = w.daemon.goal().read();
-          if (now == 1000ms && g && g->value.status == core::GoalStatus::kOk) {
-            seen = g->value.index;
-          }
-        },
-        true, config);
-    d.daemon.attach_lidar(std::move(opened.receiver));
-    d.run_until(1000ms);
+    run_in_round_room(config, 1000ms, [&](Nanos now, DaemonWithBase& w) {
+      const double heading = now > 500ms ? core::to_seconds(now - 500ms) * 1.0 : 0.0;
+      w.tracker.set_sensor_pose(-1.2, 0.3, 0.0, std::numbers::pi + heading);
+      const auto g = w.daemon.goal().read();
+      if (now == 1000ms && g && g->value.status == core::GoalStatus::kOk) seen = g->value.index;
+    });
     return seen;
   };
   const int paper = index_at_1s(0.0);
