@@ -483,6 +483,7 @@ void Daemon::policy_task(const core::Tick& tick) {
         standoff_velocity_.base(h.velocity_odom, h.velocity_base, robot_odom, tick.now);
     space_.update(h.pose_base, robot_odom, *map, velocity_base, h.yaw_rate_radps);
     core::Selection s = core::select_by_objective(space_, goal_hold_.index());
+    bool objective_chose = true;  // false below when a baseline or the policy chooses instead
     if (selector_ == Selector::kFixedBehind || selector_ == Selector::kFixedSide) {
       // Evaluation baselines: one point of W, free or not (phi = pi behind, pi/2 the left side).
       const bool behind = selector_ == Selector::kFixedBehind;
@@ -492,6 +493,7 @@ void Daemon::policy_task(const core::Tick& tick) {
       s.index = index;
       s.goal_base = space_.candidates()[static_cast<size_t>(index)].base;
       g.selector = behind ? "fixed_behind" : "fixed_side";
+      objective_chose = false;
     } else if (policy_ && selector_ == Selector::kAuto && s.status == core::GoalStatus::kOk) {
       // The learned selector: the paper's observation, masked argmax over P.
       core::ObservationInputs oi;
@@ -515,10 +517,11 @@ void Daemon::policy_task(const core::Tick& tick) {
           s.index = a;
           s.goal_base = cs[static_cast<size_t>(a)].base;
           g.selector = "policy";
+          objective_chose = false;
         }
       }
     }
-    if (std::string_view(g.selector) == "objective") {
+    if (objective_chose) {  // neither a baseline's fixed point nor the policy's
       s = goal_slew_.update(s, goal_hold_.index(), space_, tick.period);
     }
     s = goal_hold_.update(s, space_, tick.now);

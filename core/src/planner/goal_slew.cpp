@@ -6,11 +6,15 @@
 namespace core {
 namespace {
 
+int wrap(int i, int n) {
+  return ((i % n) + n) % n;
+}  // an index round W
+
 // All points strictly after `from` up to `to` going `dir` (+1 / -1) round W are free.
 bool free_way(std::span<const Candidate> points, int from, int steps, int dir) {
   const int n = static_cast<int>(points.size());
   for (int k = 1; k <= steps; ++k) {
-    const int i = ((from + dir * k) % n + n) % n;
+    const int i = wrap(from + dir * k, n);
     if (!points[static_cast<size_t>(i)].free) return false;
   }
   return true;
@@ -27,8 +31,8 @@ Selection GoalSlew::update(const Selection& chosen, int from_index, const Intera
     carry_points_ = 0.0;
     return chosen;
   }
-  const int ahead = ((chosen.index - from_index) % n + n) % n;  // steps going +1
-  const int behind = n - ahead;                                 // steps going -1
+  const int ahead = wrap(chosen.index - from_index, n);  // steps going +1
+  const int behind = n - ahead;                          // steps going -1
   const bool free_ahead = free_way(points, from_index, ahead, +1);
   const bool free_behind = free_way(points, from_index, behind, -1);
   int dir = 0;
@@ -49,10 +53,7 @@ Selection GoalSlew::update(const Selection& chosen, int from_index, const Intera
   // (1e-9: 30 points a second over a period of 33 333 333 ns is a whole step, not 0.99999999.)
   const int steps = std::clamp(static_cast<int>(std::floor(budget + 1e-9)), min_steps, distance);
   carry_points_ = steps == distance ? 0.0 : std::max(0.0, budget - steps);
-  if (steps == 0) {
-    return Selection{GoalStatus::kOk, from_index, points[static_cast<size_t>(from_index)].base};
-  }
-  const int index = ((from_index + dir * steps) % n + n) % n;
+  const int index = wrap(from_index + dir * steps, n);  // steps = 0: the point in use
   return Selection{GoalStatus::kOk, index, points[static_cast<size_t>(index)].base};
 }
 
