@@ -185,6 +185,10 @@ core::MppiConfig mppi_config(const DaemonConfig& cfg) {
       core::TwistLimits{cfg.limits.vx_max_mps, cfg.limits.vy_max_mps, cfg.limits.wz_max_radps};
   c.reverse_speed_max_mps = m.reverse_speed_max_mps;
   c.closing = closing_speed_config(cfg);
+  c.obstacle_speed.robot_decel_mps2 = cfg.obstacle_speed.robot_decel_mps2;
+  c.obstacle_speed.reaction_time_s = cfg.obstacle_speed.reaction_time_s;
+  c.obstacle_speed.margin_m = cfg.obstacle_speed.margin_m;
+  c.obstacle_speed.footprint = c.closing.footprint;
   c.linear_accel_mps2 = cfg.limits.linear_accel_max_mps2;
   c.angular_accel_radps2 = cfg.limits.angular_accel_max_radps2;
   c.threads = static_cast<int>(m.threads);
@@ -643,6 +647,7 @@ bool Daemon::run_controller(Nanos now, core::BodyVelocity& requested) {
   control_state_.repaired = out.repaired;
   if (out.repaired) ++control_state_.repairs;
   if (out.closing_limited) ++control_state_.closing_limits;
+  if (out.obstacle_limited) ++control_state_.obstacle_limits;
   if (out.guided) ++control_state_.guided_plans;
   if (out.path_planned) ++control_state_.paths_planned;
   if (out.path_guided) ++control_state_.path_guided_plans;

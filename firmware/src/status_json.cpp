@@ -95,6 +95,7 @@ std::string Daemon::build_status_json(core::Nanos now) const {
                     {"failures", v.failures},
                     {"repairs", v.repairs},
                     {"closing_limits", v.closing_limits},
+                    {"obstacle_limits", v.obstacle_limits},
                     {"guided_plans", v.guided_plans},
                     {"paths_planned", v.paths_planned},
                     {"path_guided_plans", v.path_guided_plans},

@@ -69,7 +69,7 @@ std::string csv_header() {
          "side_behind_left,side_behind,side_behind_right,side_right,side_front_right,"
          "policy_p50_ms,policy_p99_ms,control_p50_ms,control_p99_ms,wall_s,"
          "control_steps,control_failures,qp_repairs,closing_limits,guided_plans,paths_planned,"
-         "path_guided_plans,orbits_planned,orbit_guided_plans\n";
+         "path_guided_plans,orbits_planned,orbit_guided_plans,obstacle_limits\n";
 }
 
 std::string csv_row(const Outcome& o, const std::string& scenario) {
@@ -82,7 +82,7 @@ std::string csv_row(const Outcome& o, const std::string& scenario) {
   return fmt::format(
       "{},{},{},{},{},{},{},{:.2f},{:.2f},{:.3f},{:.3f},{:.4f},{:.4f},{:.4f},{:.3f},{:.3f},{:.3f},"
       "{:.2f},{:.3f},{:.3f},{:.2f},{}{},{:.4f},{:.4f},{:.4f},{:.4f},{:.2f},{},{},{},{},{},{},{},{},"
-      "{}\n",
+      "{},{}\n",
       o.trial.c->name, o.trial.method->name, o.trial.seed, scenario, m.success ? 1 : 0, failure,
       m.collision ? 1 : 0, m.duration_s, m.active_s, m.uncomfortable_s, m.inside_ellipse_s,
       m.rmse_ex_m, m.rmse_ey_m, m.rmse_etheta_rad, m.min_person_distance_m,
@@ -91,7 +91,8 @@ std::string csv_row(const Outcome& o, const std::string& scenario) {
       m.rms_jerk, m.stops, sides, o.policy_p50_ms, o.policy_p99_ms, o.control_p50_ms,
       o.control_p99_ms, o.wall_s, o.controller.steps, o.controller.failures, o.controller.repairs,
       o.controller.closing_limits, o.controller.guided_plans, o.controller.paths_planned,
-      o.controller.path_guided_plans, o.controller.orbits_planned, o.controller.orbit_guided_plans);
+      o.controller.path_guided_plans, o.controller.orbits_planned, o.controller.orbit_guided_plans,
+      o.controller.obstacle_limits);
 }
 
 std::string causes_text(const std::map<std::string, int>& causes) {

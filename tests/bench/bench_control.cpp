@@ -12,6 +12,7 @@
 #include "core/control/closing_speed.hpp"
 #include "core/control/costmap_path.hpp"
 #include "core/control/mppi.hpp"
+#include "core/control/obstacle_speed.hpp"
 #include "core/perception/costmap.hpp"
 #include "core/perception/voxel_grid.hpp"
 #include "core/planner/interactive_space.hpp"
@@ -247,6 +248,40 @@ void BM_CostmapPath(benchmark::State& state) {
   state.counters["expansions"] = planner.expansions();
 }
 BENCHMARK(BM_CostmapPath)->ArgName("closed")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+// The obstacle speed limit on the command (obstacle_speed.hpp), inside the closed box of
+// wall_scene(true) (3 x 4.5 m), the robot 0.2-0.8 m off its west wall, for a spread of poses and
+// commands up to the limits: the obstacle cells in reach gathered from the costmap, then the
+// projections. `speed` scales the commands (the window grows with the stopping distance).
+void BM_ObstacleSpeedLimit(benchmark::State& state) {
+  const core::Costmap map = wall_scene(true);
+  core::ObstacleSpeedConfig c;
+  c.robot_decel_mps2 = 1.0;
+  core::ObstacleSpeedLimit limit(c);
+  const double speed = static_cast<double>(state.range(0)) / 100.0;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> x(2.0, 2.6), y(-1.0, 2.5), th(-3.1, 3.1);
+  std::uniform_real_distribution<double> vx(-1.8, 1.8), vy(-1.5, 1.5), wz(-2.0, 2.0);
+  std::vector<std::pair<core::Pose2, core::Twist>> cases(256);
+  for (auto& [pose, u] : cases) {
+    pose = core::Pose2{x(rng), y(rng), th(rng)};
+    u = core::Twist{speed * vx(rng), speed * vy(rng), speed * wz(rng)};
+  }
+  size_t i = 0;
+  int limited = 0;
+  for (auto _ : state) {
+    const auto& [pose, u] = cases[i++ & 255U];
+    const auto r = limit.apply(map, pose, u);
+    limited += r.limited ? 1 : 0;
+    benchmark::DoNotOptimize(r);
+  }
+  state.counters["limited"] = benchmark::Counter(limited, benchmark::Counter::kAvgIterations);
+}
+BENCHMARK(BM_ObstacleSpeedLimit)
+    ->ArgName("speed_pct")
+    ->Arg(50)
+    ->Arg(100)
+    ->Unit(benchmark::kMicrosecond);
 
 // Warms the controller up (20 steps at 100 Hz), then times one step per iteration; the counter
 // `name` says whether the last timed step had `flag` set (the option under test acted).

@@ -738,6 +738,40 @@ TEST(ClosedLoop, LeadsThePersonOutOfADeadEnd) {
   EXPECT_LT(r.metrics.uncomfortable_s, 0.5);
 }
 
+TEST(ClosedLoop, TheObstacleSpeedLimitKeepsTheRobotOffTheDeadEndsWall) {
+  // The dead end, seed 2, with q^d held behind the person (the fixed_behind baseline, as
+  // companion-eval runs it): they turn back at the end and walk at the robot, which sidesteps to
+  // get behind them and, its plan squeezed between their ellipse and the wall, drives its corner
+  // into the wall at 17.4 s (docs/EVALUATION.md, thirty-third session). obstacle_speed.* keeps
+  // every command within what stops short of the wall.
+  auto run = [](double robot_decel_mps2, uint64_t& limited) {
+    SimRunOptions o;
+    o.config = defaults();
+    o.config.policy.selector = "fixed_behind";
+    o.config.mppi.threads = 1;  // as companion-eval's trials
+    o.config.obstacle_speed.robot_decel_mps2 = robot_decel_mps2;
+    o.scenario = *sim::make_scenario("dead_end", 2);
+    o.seed = 2;
+    o.duration_s = 19.0;
+    o.script = [&](double, sim::SimWorld&, firmware::Daemon& d) {
+      if (const auto c = d.control_status().read()) limited = c->value.obstacle_limits;
+    };
+    return sim::run_simulation(o);
+  };
+  uint64_t limited_off = 0;
+  uint64_t limited_on = 0;
+  const auto off = run(0.0, limited_off);
+  const auto on = run(1.0, limited_on);
+  print("obstacle speed off", off);
+  print("obstacle speed on", on);
+  ASSERT_EQ(off.metrics.failure_kind, sim::FailureKind::kHitObstacle)
+      << "the situation this test is about: " << off.metrics.failure;
+  EXPECT_EQ(limited_off, 0U);
+  EXPECT_FALSE(on.metrics.collision) << on.metrics.failure;
+  EXPECT_GT(limited_on, 0U) << "the limit acted";
+  EXPECT_GT(on.metrics.min_static_clearance_m, 0.02);
+}
+
 // ---- the evaluation's baselines, as configuration -------------------------------------------
 
 TEST(ClosedLoop, FixedPointBaselinesHoldTheirPointOfTheInteractiveSpace) {

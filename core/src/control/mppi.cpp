@@ -70,6 +70,7 @@ Mppi::Mppi(const MppiConfig& config)
       collision_cost_(cost_.size()),
       barrier_cost_(cost_.size()),
       weight_(cost_.size()),
+      obstacle_limit_(config.obstacle_speed),
       rng_state_(config.seed * 0x9E3779B97F4A7C15ULL + 1) {
   if (config.guide_samples) {
     guide_block_ = offset_.size() - 1;
@@ -708,6 +709,11 @@ MppiOutput Mppi::step(const MppiInputs& in) {
       u = c.u;
       out.closing_limited = c.limited;
     }
+  }
+  if (in.costmap != nullptr) {
+    const ObstacleSpeedResult o = obstacle_limit_.apply(*in.costmap, in.robot, u);
+    u = o.u;
+    out.obstacle_limited = o.limited;
   }
   // Acceleration limits against the last command, over the time since the last step.
   const double dv = cfg_.linear_accel_mps2 * elapsed;

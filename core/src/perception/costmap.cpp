@@ -50,6 +50,7 @@ Costmap::Costmap(int cells, double resolution_m)
     : n_(cells),
       res_(resolution_m),
       cost_(static_cast<size_t>(cells) * static_cast<size_t>(cells), 0),
+      obstacle_(cost_.size(), 0),
       dist2_(cost_.size(), kInf),
       row_(static_cast<size_t>(cells)),
       f_(static_cast<size_t>(cells)),
@@ -124,6 +125,7 @@ void Costmap::build(const VoxelGrid& grid, const CostmapConfig& config, Nanos st
     const float d2 = dist2_[c];
     // d2 holds an exact integer (a sum of squared cell offsets): truncation is exact.
     cost_[c] = d2 <= limit ? lut_[static_cast<size_t>(d2)] : 0;
+    obstacle_[c] = d2 == 0.0f ? 1 : 0;
   }
   build_quad_ranges();
 }
@@ -167,6 +169,7 @@ void Costmap::copy_cells_from(const Costmap& other) {
   stamp_ = other.stamp_;
   obstacles_ = other.obstacles_;
   cost_.assign(other.cost_.begin(), other.cost_.end());  // no allocation once sized
+  obstacle_.assign(other.obstacle_.begin(), other.obstacle_.end());
   quad_range_.assign(other.quad_range_.begin(), other.quad_range_.end());
 }
 

@@ -1044,6 +1044,34 @@ std::vector<FieldSpec> build() {
        0.0,
        1.0,
        {}},
+      {"obstacle_speed.robot_decel_mps2",
+       "m/s^2",
+       "Speed and separation toward obstacles (the costmap's obstacle cells, pedestrians "
+       "included, as if standing): the last stage of the controller's command, after the "
+       "barrier's repair and closing_speed.*, so that nothing drives the footprint toward an "
+       "obstacle faster than it can stop from at this deceleration, after "
+       "obstacle_speed.reaction_time_s, obstacle_speed.margin_m short of it. Changes only the "
+       "motion toward obstacles (motion along a wall is kept), never adds motion toward one. "
+       "0: off (the paper's controller).",
+       FIELD(obstacle_speed.robot_decel_mps2),
+       0.0,
+       10.0,
+       {}},
+      {"obstacle_speed.reaction_time_s",
+       "s",
+       "Time before braking begins: the control period plus the base's command latency.",
+       FIELD(obstacle_speed.reaction_time_s),
+       0.0,
+       1.0,
+       {}},
+      {"obstacle_speed.margin_m",
+       "m",
+       "Gap left between the robot's footprint (costmap.footprint_*) and an obstacle cell's "
+       "centre after a stop.",
+       FIELD(obstacle_speed.margin_m),
+       0.0,
+       1.0,
+       {}},
   };
 }
 

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numbers>
 #include <random>
 
@@ -594,4 +595,157 @@ TEST(Mppi, TheOrbitSampleGoesRoundThePersonToTheirOtherSide) {
   EXPECT_LT(with_orbit.final_distance_m, 0.2) << "round to q^d";
   EXPECT_GE(with_orbit.min_h, -0.02) << "round the ellipse, not through it";
   EXPECT_FALSE(with_orbit.planned_at_end) << "at q^d the orbit sample no longer runs";
+}
+
+// Speed and separation toward obstacles (core/control/obstacle_speed.hpp).
+namespace {
+
+core::ObstacleSpeedConfig obstacle_speed_on() {
+  core::ObstacleSpeedConfig c;
+  c.robot_decel_mps2 = 1.0;
+  return c;
+}
+
+// Each obstacle cell of `map` within 4 m: how fast the footprint's nearest point moves toward
+// it under `u`, less what stops in the gap (> 0: the limit broken), the largest over the cells;
+// derived here from the costmap and the footprint, not from the limiter's own bookkeeping.
+double worst_excess_mps(const core::Costmap& map, const Pose2& robot, const Twist& u,
+                        const core::ObstacleSpeedConfig& c) {
+  double worst = -1e9;
+  const Pose2 odom_in_base = robot.inverse();
+  for (int j = 0; j < map.cells(); ++j) {
+    for (int i = 0; i < map.cells(); ++i) {
+      if (!map.obstacle(i, j)) continue;
+      const core::Point2 p = odom_in_base.apply({map.origin_x() + (i + 0.5) * map.resolution(),
+                                                 map.origin_y() + (j + 0.5) * map.resolution()});
+      if (std::hypot(p.x_m, p.y_m) > 4.0) continue;
+      const core::Point2 q = c.footprint.nearest(p);
+      const double gap = std::hypot(p.x_m - q.x_m, p.y_m - q.y_m);
+      if (gap < 1e-9) return std::numeric_limits<double>::infinity();  // inside the footprint
+      const double nx = (p.x_m - q.x_m) / gap;
+      const double ny = (p.y_m - q.y_m) / gap;
+      const double toward = nx * (u.vx - u.wz * q.y_m) + ny * (u.vy + u.wz * q.x_m);
+      worst = std::max(worst, toward - core::max_approach_speed_mps(gap, c));
+    }
+  }
+  return worst;
+}
+
+}  // namespace
+
+TEST(ObstacleSpeed, TheLimitStopsInTheGapLeft) {
+  const core::ObstacleSpeedConfig c = obstacle_speed_on();
+  for (const double gap : {0.1, 0.3, 0.6, 1.2}) {
+    const double v = core::max_approach_speed_mps(gap, c);
+    EXPECT_NEAR(v * c.reaction_time_s + v * v / (2.0 * c.robot_decel_mps2), gap - c.margin_m, 1e-12)
+        << gap;
+  }
+  EXPECT_EQ(core::max_approach_speed_mps(c.margin_m, c), 0.0);
+  EXPECT_EQ(core::max_approach_speed_mps(-0.1, c), 0.0) << "touching: never closer";
+}
+
+TEST(ObstacleSpeed, OffOrWithoutObstaclesTheCommandIsLeftAlone) {
+  const core::Costmap map = wall_map();
+  const Twist u{1.8, 0.3, 0.5};
+  core::ObstacleSpeedLimit off{core::ObstacleSpeedConfig{}};  // robot_decel_mps2 = 0
+  const auto r = off.apply(map, Pose2{0.9, 0, 0}, u);
+  EXPECT_FALSE(r.limited);
+  EXPECT_EQ(r.u.vx, u.vx);
+  core::ObstacleSpeedLimit on(obstacle_speed_on());
+  const auto far = on.apply(map, Pose2{-2.5, 0, 0}, u);  // 4 m short of it
+  EXPECT_FALSE(far.limited);
+  EXPECT_EQ(far.obstacle_cells_looked, 0) << "beyond a stop from this speed: not even looked at";
+  const auto empty = on.apply(core::Costmap{}, Pose2{0.9, 0, 0}, u);
+  EXPECT_FALSE(empty.limited);
+}
+
+TEST(ObstacleSpeed, StraightAtAWallTheSpeedIsWhatStopsShortOfIt) {
+  const core::Costmap map = wall_map();  // obstacle cells at x = 1.5 m, |y| <= 0.6 m
+  core::ObstacleSpeedLimit limit(obstacle_speed_on());
+  for (const double x : {-0.5, 0.3, 0.7, 1.0}) {
+    const Pose2 robot{x, 0.0, 0.0};  // the front face at x + 0.35
+    const auto r = limit.apply(map, robot, Twist{1.8, 0.0, 0.0});
+    const double allowed = core::max_approach_speed_mps(r.nearest_gap_m, limit.config());
+    EXPECT_TRUE(r.limited) << x;
+    EXPECT_NEAR(r.nearest_gap_m, 1.5 - 0.35 - x, 0.03) << x;  // to the nearest cell's centre
+    EXPECT_LE(r.u.vx, allowed + 1e-9) << x;
+    EXPECT_GE(r.u.vx, 0.9 * allowed) << x << ": slowed to the limit, not stopped";
+    EXPECT_LE(worst_excess_mps(map, robot, r.u, limit.config()), 1e-9) << x;
+  }
+  // Away from the wall, even touching it: never held.
+  const auto away = limit.apply(map, Pose2{1.1, 0, 0}, Twist{-1.0, 0.0, 0.0});
+  EXPECT_FALSE(away.limited);
+}
+
+TEST(ObstacleSpeed, ThePartAlongAWallIsKeptWhereScalingWouldStopIt) {
+  // A long wall at x = 1.5 m to the robot's right, 0.25 m from its side; the command runs along
+  // the wall at 1 m/s and toward it at 0.8 m/s.
+  const core::Costmap map = wall_map(-4.0, 4.0);
+  core::ObstacleSpeedLimit limit(obstacle_speed_on());
+  const Pose2 robot{1.5 - 0.3 - 0.25, 0.0, std::numbers::pi / 2};  // facing +y: right is +x
+  const Twist u{1.0, -0.8, 0.0};
+  const auto r = limit.apply(map, robot, u);
+  EXPECT_TRUE(r.limited);
+  EXPECT_LE(worst_excess_mps(map, robot, r.u, limit.config()), 1e-9);
+  EXPECT_GT(worst_excess_mps(map, robot, u, limit.config()), 0.3) << "the command broke it";
+  EXPECT_GT(r.u.vx, 0.6) << "still moving along the wall";
+  EXPECT_GT(r.u.vy, -0.5) << "much less toward it";
+}
+
+TEST(ObstacleSpeed, ACornerSwungIntoAWallIsSlowed) {
+  // The robot beside the wall, 0.1 m off it; turning right swings its front-right corner into it.
+  const core::Costmap map = wall_map(-4.0, 4.0);
+  core::ObstacleSpeedLimit limit(obstacle_speed_on());
+  const Pose2 robot{1.5 - 0.3 - 0.1, 0.0, std::numbers::pi / 2};
+  const auto r = limit.apply(map, robot, Twist{0.0, 0.0, -2.0});
+  EXPECT_TRUE(r.limited);
+  EXPECT_GT(worst_excess_mps(map, robot, Twist{0.0, 0.0, -2.0}, limit.config()), 0.3);
+  // The corner 0.35 m ahead of the centre, 0.125 m from the cells' centres: ~0.34 m/s, ~1 rad/s.
+  EXPECT_GT(r.u.wz, -1.1) << "the turn is slowed";
+  EXPECT_LT(r.u.wz, -0.9) << "to the limit, not stopped";
+  EXPECT_EQ(r.u.vx, 0.0) << "nothing added";
+  EXPECT_EQ(r.u.vy, 0.0) << "nothing added";
+  EXPECT_LE(worst_excess_mps(map, robot, r.u, limit.config()), 1e-9);
+  const auto left = limit.apply(map, robot, Twist{0.0, 0.0, 0.5});
+  EXPECT_LE(worst_excess_mps(map, robot, left.u, limit.config()), 1e-9);
+}
+
+TEST(ObstacleSpeed, EveryLimitHoldsAndNothingSpeedsUpForRandomPosesAndCommands) {
+  // An L of walls (x = 1.5 m, and y = 1.0 m for x in 1.5..3.5) round random poses and commands.
+  core::VoxelGridConfig gc;
+  gc.size_xy_m = 10.0;
+  core::VoxelGrid g(gc);
+  g.recentre(1.5, 0);
+  std::vector<core::Ray> rays;
+  for (double y = -1.5; y <= 1.0; y += 0.02)
+    rays.push_back({{1.5, -3.0, 3.0}, {1.5, y, 0.5}});
+  for (double x = 1.5; x <= 3.5; x += 0.02)
+    rays.push_back({{x, -3.0, 3.0}, {x, 1.0, 0.5}});
+  g.insert(rays, Pose2{30, 30, 0}, std::nullopt, 1s);
+  core::Costmap map;
+  map.build(g, core::CostmapConfig{}, 1s);
+  core::ObstacleSpeedLimit limit(obstacle_speed_on());
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> px(-1.0, 0.95), py(-1.0, 2.5), th(-3.14, 3.14);
+  std::uniform_real_distribution<double> vx(-1.8, 1.8), vy(-1.5, 1.5), wz(-2.0, 2.0);
+  int limited = 0;
+  int tried = 0;
+  while (tried < 400) {
+    const Pose2 robot{px(rng), py(rng), th(rng)};
+    if (std::isinf(worst_excess_mps(map, robot, Twist{}, limit.config()))) continue;  // inside
+    ++tried;
+    const Twist u{vx(rng), vy(rng), wz(rng)};
+    const auto r = limit.apply(map, robot, u);
+    ASSERT_LE(worst_excess_mps(map, robot, r.u, limit.config()), 1e-9)
+        << robot.x_m << " " << robot.y_m << " " << robot.theta_rad;
+    for (const auto& [out, in] : {std::pair{r.u.vx, u.vx}, {r.u.vy, u.vy}, {r.u.wz, u.wz}}) {
+      EXPECT_GE(out * in, 0.0) << "never reversed";
+      EXPECT_LE(std::abs(out), std::abs(in)) << "never faster";
+    }
+    if (worst_excess_mps(map, robot, u, limit.config()) <= 0.0) {
+      EXPECT_FALSE(r.limited) << "a command within every limit is left alone";
+    }
+    limited += r.limited ? 1 : 0;
+  }
+  EXPECT_GT(limited, 50) << "the poses are near enough the walls to test anything";
 }

@@ -528,6 +528,39 @@ TEST(Costmap, DistanceTransformIsExact) {
   }
 }
 
+// The obstacle layer (what the controller's obstacle speed limit reads): exactly the columns
+// with an occupied voxel, not the lethal ring the inflation puts round them; rebuilt with the
+// cells, carried by a snapshot's copy, false off the map.
+TEST(Costmap, ObstacleCellsAreTheOccupiedColumnsAndTravelWithACopy) {
+  core::VoxelGrid g = four_metre_grid();
+  std::mt19937 rng(5);
+  core::Costmap m;
+  auto check = [&](const core::Costmap& map, const char* what) {
+    size_t obstacles = 0;
+    size_t lethal_not_obstacle = 0;
+    for (int j = 0; j < map.cells(); ++j) {
+      for (int i = 0; i < map.cells(); ++i) {
+        ASSERT_EQ(map.obstacle(i, j), g.column(i, j) != 0) << what << " " << i << "," << j;
+        obstacles += map.obstacle(i, j) ? 1U : 0U;
+        lethal_not_obstacle += !map.obstacle(i, j) && map.cell(i, j) == core::kCostLethal;
+      }
+    }
+    EXPECT_EQ(obstacles, map.obstacle_cells()) << what;
+    EXPECT_GT(lethal_not_obstacle, 0U) << what << ": the inscribed ring is lethal, not obstacle";
+    EXPECT_FALSE(map.obstacle(-1, 0));
+    EXPECT_FALSE(map.obstacle(0, map.cells()));
+  };
+  scatter_obstacles(g, rng, 25, 1s);
+  m.build(g, core::CostmapConfig{}, 1s);
+  check(m, "built");
+  scatter_obstacles(g, rng, 25, 2s);
+  m.build(g, core::CostmapConfig{}, 2s);
+  check(m, "rebuilt");
+  core::Costmap copy;
+  copy.copy_cells_from(m);
+  check(copy, "copied");
+}
+
 // The controller's collision test (cost_at_least: a quad's cell range decides most points
 // without interpolating) gives exactly the answer of cost(x, y) >= threshold: everywhere on and
 // off the map, on cell centres and quad edges, at the thresholds where rounding could tell them

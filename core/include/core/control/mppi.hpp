@@ -22,6 +22,7 @@
 #include "core/control/closing_speed.hpp"
 #include "core/control/costmap_path.hpp"
 #include "core/control/dcbf_repair.hpp"
+#include "core/control/obstacle_speed.hpp"
 #include "core/geometry/pose2.hpp"
 #include "core/perception/costmap.hpp"
 #include "core/time.hpp"
@@ -69,6 +70,9 @@ struct MppiConfig {
   // Speed and separation toward the person, applied to the repaired command (closing_speed.hpp;
   // robot_decel_mps2 = 0: off).
   ClosingSpeedConfig closing;
+  // Speed and separation toward obstacles, applied after it (obstacle_speed.hpp; not in the
+  // paper; robot_decel_mps2 = 0: off).
+  ObstacleSpeedConfig obstacle_speed;
   double linear_accel_mps2 = 1.5;  // applied to the output command
   double angular_accel_radps2 = 3.0;
   bool smooth = true;  // 3-tap smoothing of the updated mean sequence
@@ -138,6 +142,7 @@ struct MppiOutput {
   bool repaired = false;
   bool repair_feasible = true;
   bool closing_limited = false;  // slowed toward the person (ClosingSpeedConfig)
+  bool obstacle_limited = false;  // changed toward an obstacle (ObstacleSpeedConfig)
   bool guided = false;           // a structured sample beat every random one and became the plan
   bool path_planned = false;     // an obstacle lay on the line to q^d and a path round it was found
   bool path_guided = false;      // ... and its sample became the plan
@@ -193,6 +198,7 @@ class Mppi {
   std::vector<float> tracking_cost_, collision_cost_, barrier_cost_;  // per sample, by term
   std::vector<double> weight_;                                        // per sample
   std::vector<uint32_t> active_;  // samples that carry weight (capacity M: no allocation)
+  ObstacleSpeedLimit obstacle_limit_;
   uint64_t rng_state_;
   // Prepared once per step for the rollouts.
   struct PersonFrame {

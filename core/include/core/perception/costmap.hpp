@@ -91,6 +91,13 @@ class Costmap {
   }
   [[nodiscard]] const std::vector<uint8_t>& data() const { return cost_; }
   [[nodiscard]] size_t obstacle_cells() const { return obstacles_; }
+  // Whether cell (i, j) holds an obstacle itself (a column of occupied voxels; the cost is
+  // lethal round it too, out to the inscribed radius). Off the map: false (nothing seen there).
+  [[nodiscard]] bool obstacle(int i, int j) const {
+    if (i < 0 || j < 0 || i >= n_ || j >= n_) return false;
+    return obstacle_[static_cast<size_t>(j) * static_cast<size_t>(n_) + static_cast<size_t>(i)] !=
+           0;
+  }
 
  private:
   // Bounds the rounding of a bilinear value (a few ulp of 100) in the range tests.
@@ -128,6 +135,7 @@ class Costmap {
   Nanos stamp_{0};
   size_t obstacles_ = 0;
   std::vector<uint8_t> cost_;
+  std::vector<uint8_t> obstacle_;  // 1 where the cell is an obstacle (distance 0)
   // (n + 1) x (n + 1), row j + 1, column i + 1 (an empty map: its one quad, all off the map)
   std::vector<CellRange> quad_range_ =
       std::vector<CellRange>(1, CellRange{kCostLethal, kCostLethal});

@@ -173,6 +173,12 @@ struct DaemonConfig {
     double margin_m = 0;
     double person_radius_m = 0;
   } closing_speed;
+
+  struct ObstacleSpeed {
+    double robot_decel_mps2 = 0;  // 0: off
+    double reaction_time_s = 0;
+    double margin_m = 0;
+  } obstacle_speed;
 };
 
 }  // namespace firmware
