@@ -717,10 +717,10 @@ TEST(ObstacleSpeed, EveryLimitHoldsAndNothingSpeedsUpForRandomPosesAndCommands) 
   core::VoxelGrid g(gc);
   g.recentre(1.5, 0);
   std::vector<core::Ray> rays;
-  for (double y = -1.5; y <= 1.0; y += 0.02)
-    rays.push_back({{1.5, -3.0, 3.0}, {1.5, y, 0.5}});
-  for (double x = 1.5; x <= 3.5; x += 0.02)
-    rays.push_back({{x, -3.0, 3.0}, {x, 1.0, 0.5}});
+  for (int k = 0; k <= 125; ++k) {  // every 2 cm
+    rays.push_back({{1.5, -3.0, 3.0}, {1.5, -1.5 + 0.02 * k, 0.5}});
+    if (k <= 100) rays.push_back({{1.5 + 0.02 * k, -3.0, 3.0}, {1.5 + 0.02 * k, 1.0, 0.5}});
+  }
   g.insert(rays, Pose2{30, 30, 0}, std::nullopt, 1s);
   core::Costmap map;
   map.build(g, core::CostmapConfig{}, 1s);
