@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <numeric>
 
 #include "core/policy/observation.hpp"
@@ -420,6 +421,35 @@ TEST(ClosedLoop, AFadedQdPredictionStaysOnTheCostmapAndTracksABriskWalkerCloser)
   EXPECT_LE(faded.metrics.rmse_ex_m, constant.metrics.rmse_ex_m + 0.02) << "no more lag";
 }
 
+// A safety limit's test: the same trial with the limit off and on (`make(on)` builds it), and
+// how often the limit acted by the end (`counter` of the control status). Off, the trial must
+// fail with `off_failure` (the situation the test is about) and the limit never act; on, it
+// must act and nothing be hit.
+struct OffAndOn {
+  sim::SimRunResult off, on;
+  uint64_t acted_off = 0, acted_on = 0;
+};
+OffAndOn run_off_and_on(const std::function<SimRunOptions(bool)>& make,
+                        uint64_t firmware::ControlStatus::*counter, const char* name,
+                        sim::FailureKind off_failure) {
+  OffAndOn r;
+  for (const bool on : {false, true}) {
+    SimRunOptions o = make(on);
+    uint64_t& acted = on ? r.acted_on : r.acted_off;
+    o.script = [&](double, sim::SimWorld&, firmware::Daemon& d) {
+      if (const auto c = d.control_status().read()) acted = c->value.*counter;
+    };
+    (on ? r.on : r.off) = sim::run_simulation(o);
+    print(std::string(name) + (on ? " on" : " off"), on ? r.on : r.off);
+  }
+  EXPECT_EQ(r.off.metrics.failure_kind, off_failure)
+      << "the situation this test is about: " << r.off.metrics.failure;
+  EXPECT_EQ(r.acted_off, 0U);
+  EXPECT_FALSE(r.on.metrics.collision) << r.on.metrics.failure;
+  EXPECT_GT(r.acted_on, 0U) << "the limit acted";
+  return r;
+}
+
 TEST(ClosedLoop, TheClosingSpeedLimitKeepsACatchingUpRobotOffATurningPerson) {
   // Random benchmark seed 25 with q^d on the faded prediction (tight tracking): the robot,
   // catching up from behind-right at ~1.75 m/s with q^d 0.7 m to the person's right, meets
@@ -427,7 +457,7 @@ TEST(ClosedLoop, TheClosingSpeedLimitKeepsACatchingUpRobotOffATurningPerson) {
   // side at 7.9 s (docs/EVALUATION.md). closing_speed.* keeps its speed toward them within what
   // it can stop from in the gap between the bodies. (The whole 60 s trial still touches them
   // at 11.5 s, where they cut across its path within its braking distance: not this test's.)
-  auto run = [](double robot_decel_mps2, uint64_t& limited) {
+  auto make = [](bool on) {
     SimRunOptions o;
     o.config = defaults();
     // The walk it was found with: the person starts at once (eased at 3 m/s^2, as the built-in
@@ -444,30 +474,18 @@ TEST(ClosedLoop, TheClosingSpeedLimitKeepsACatchingUpRobotOffATurningPerson) {
     // straight behind, and does not meet this turn).
     o.config.objective.alpha = 1.0;
     o.config.objective.beta = 0.5;
-    o.config.closing_speed.robot_decel_mps2 = robot_decel_mps2;
+    o.config.closing_speed.robot_decel_mps2 = on ? 1.0 : 0.0;
     // The controller it was found with: random samples alone (with mppi.guide_samples the robot
     // brakes out of this turn without the limit too, 0.03 m from them: no contact to prevent),
     // and the paper's heading weight (with q_theta 60 the robot turns with the person sooner and
     // misses them without the limit too).
     o.config.mppi.guide_samples = false;
     o.config.mppi.q_theta = 20.0;
-    o.script = [&](double, sim::SimWorld&, firmware::Daemon& d) {
-      if (const auto c = d.control_status().read()) limited = c->value.closing_limits;
-    };
-    return sim::run_simulation(o);
+    return o;
   };
-  uint64_t limited_off = 0;
-  uint64_t limited_on = 0;
-  const auto off = run(0.0, limited_off);
-  const auto on = run(1.0, limited_on);
-  print("closing speed off", off);
-  print("closing speed on", on);
-  ASSERT_EQ(off.metrics.failure_kind, sim::FailureKind::kHitPerson)
-      << "the situation this test is about: " << off.metrics.failure;
-  EXPECT_EQ(limited_off, 0U);
-  EXPECT_FALSE(on.metrics.collision) << on.metrics.failure;
-  EXPECT_GT(limited_on, 0U) << "the limit acted";
-  EXPECT_GT(on.metrics.min_person_distance_m, off.metrics.min_person_distance_m);
+  const auto r = run_off_and_on(make, &firmware::ControlStatus::closing_limits, "closing speed",
+                                sim::FailureKind::kHitPerson);
+  EXPECT_GT(r.on.metrics.min_person_distance_m, r.off.metrics.min_person_distance_m);
 }
 
 // mppi.path_guide through the daemon: the key reaches the controller and the status counts the
@@ -744,32 +762,20 @@ TEST(ClosedLoop, TheObstacleSpeedLimitKeepsTheRobotOffTheDeadEndsWall) {
   // get behind them and, its plan squeezed between their ellipse and the wall, drives its corner
   // into the wall at 17.4 s (docs/EVALUATION.md, thirty-third session). obstacle_speed.* keeps
   // every command within what stops short of the wall.
-  auto run = [](double robot_decel_mps2, uint64_t& limited) {
+  auto make = [](bool on) {
     SimRunOptions o;
     o.config = defaults();
     o.config.policy.selector = "fixed_behind";
     o.config.mppi.threads = 1;  // as companion-eval's trials
-    o.config.obstacle_speed.robot_decel_mps2 = robot_decel_mps2;
+    o.config.obstacle_speed.robot_decel_mps2 = on ? 1.0 : 0.0;
     o.scenario = *sim::make_scenario("dead_end", 2);
     o.seed = 2;
     o.duration_s = 19.0;
-    o.script = [&](double, sim::SimWorld&, firmware::Daemon& d) {
-      if (const auto c = d.control_status().read()) limited = c->value.obstacle_limits;
-    };
-    return sim::run_simulation(o);
+    return o;
   };
-  uint64_t limited_off = 0;
-  uint64_t limited_on = 0;
-  const auto off = run(0.0, limited_off);
-  const auto on = run(1.0, limited_on);
-  print("obstacle speed off", off);
-  print("obstacle speed on", on);
-  ASSERT_EQ(off.metrics.failure_kind, sim::FailureKind::kHitObstacle)
-      << "the situation this test is about: " << off.metrics.failure;
-  EXPECT_EQ(limited_off, 0U);
-  EXPECT_FALSE(on.metrics.collision) << on.metrics.failure;
-  EXPECT_GT(limited_on, 0U) << "the limit acted";
-  EXPECT_GT(on.metrics.min_static_clearance_m, 0.02);
+  const auto r = run_off_and_on(make, &firmware::ControlStatus::obstacle_limits, "obstacle speed",
+                                sim::FailureKind::kHitObstacle);
+  EXPECT_GT(r.on.metrics.min_static_clearance_m, 0.02);
 }
 
 // ---- the evaluation's baselines, as configuration -------------------------------------------

@@ -206,10 +206,16 @@ SimRunResult run_simulation(const SimRunOptions& o) {
   result.samples = recorder.samples();
   if (const auto c = daemon.control_status().read()) {
     const firmware::ControlStatus& v = c->value;
-    result.controller = ControllerCounts{
-        v.runs,          v.failures,          v.repairs,        v.closing_limits,    v.guided_plans,
-        v.paths_planned, v.path_guided_plans, v.orbits_planned, v.orbit_guided_plans,
-        v.obstacle_limits};
+    result.controller = ControllerCounts{v.runs,
+                                         v.failures,
+                                         v.repairs,
+                                         v.closing_limits,
+                                         v.guided_plans,
+                                         v.paths_planned,
+                                         v.path_guided_plans,
+                                         v.orbits_planned,
+                                         v.orbit_guided_plans,
+                                         v.obstacle_limits};
   }
   result.final_status = daemon.status_line();
   result.wall_s = std::chrono::duration<double>(Clock::now() - wall_start).count();

@@ -118,8 +118,9 @@ TEST(Mppi, NeverEntersTheEllipseOfAPersonWalkingTowardTheRobot) {
   }
 }
 
-// A wall along x = 1.5 m from y_min to y_max (marked by rays from high above).
-core::Costmap wall_map(double y_min_m = -0.6, double y_max_m = 0.6) {
+// A wall along x = 1.5 m from y_min to y_max and, with top_x_end > 1.5, another along y = y_max
+// from there to x = top_x_end (an L), marked by rays from high above.
+core::Costmap wall_map(double y_min_m = -0.6, double y_max_m = 0.6, double top_x_end_m = 1.5) {
   core::VoxelGridConfig gc;
   gc.size_xy_m = 10.0;
   core::VoxelGrid g(gc);
@@ -127,6 +128,8 @@ core::Costmap wall_map(double y_min_m = -0.6, double y_max_m = 0.6) {
   std::vector<core::Ray> rays;
   for (double y = y_min_m; y <= y_max_m; y += 0.02)
     rays.push_back({{1.5, -3.0, 3.0}, {1.5, y, 0.5}});
+  for (int k = 1; 1.5 + 0.02 * k <= top_x_end_m; ++k)
+    rays.push_back({{1.5 + 0.02 * k, -3.0, 3.0}, {1.5 + 0.02 * k, y_max_m, 0.5}});
   g.insert(rays, Pose2{30, 30, 0}, std::nullopt, 1s);
   core::Costmap m;
   m.build(g, core::CostmapConfig{}, 1s);
@@ -712,18 +715,7 @@ TEST(ObstacleSpeed, ACornerSwungIntoAWallIsSlowed) {
 
 TEST(ObstacleSpeed, EveryLimitHoldsAndNothingSpeedsUpForRandomPosesAndCommands) {
   // An L of walls (x = 1.5 m, and y = 1.0 m for x in 1.5..3.5) round random poses and commands.
-  core::VoxelGridConfig gc;
-  gc.size_xy_m = 10.0;
-  core::VoxelGrid g(gc);
-  g.recentre(1.5, 0);
-  std::vector<core::Ray> rays;
-  for (int k = 0; k <= 125; ++k) {  // every 2 cm
-    rays.push_back({{1.5, -3.0, 3.0}, {1.5, -1.5 + 0.02 * k, 0.5}});
-    if (k <= 100) rays.push_back({{1.5 + 0.02 * k, -3.0, 3.0}, {1.5 + 0.02 * k, 1.0, 0.5}});
-  }
-  g.insert(rays, Pose2{30, 30, 0}, std::nullopt, 1s);
-  core::Costmap map;
-  map.build(g, core::CostmapConfig{}, 1s);
+  const core::Costmap map = wall_map(-1.5, 1.0, 3.5);
   core::ObstacleSpeedLimit limit(obstacle_speed_on());
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> px(-1.0, 0.95), py(-1.0, 2.5), th(-3.14, 3.14);

@@ -141,9 +141,9 @@ struct MppiOutput {
   bool ok = false;  // false: numerical failure, command is zero
   bool repaired = false;
   bool repair_feasible = true;
-  bool closing_limited = false;  // slowed toward the person (ClosingSpeedConfig)
+  bool closing_limited = false;   // slowed toward the person (ClosingSpeedConfig)
   bool obstacle_limited = false;  // changed toward an obstacle (ObstacleSpeedConfig)
-  bool guided = false;           // a structured sample beat every random one and became the plan
+  bool guided = false;            // a structured sample beat every random one and became the plan
   bool path_planned = false;     // an obstacle lay on the line to q^d and a path round it was found
   bool path_guided = false;      // ... and its sample became the plan
   bool orbit_planned = false;    // q^d lay across the person's ellipse: the orbit sample ran
