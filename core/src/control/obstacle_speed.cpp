@@ -130,19 +130,11 @@ ObstacleSpeedResult ObstacleSpeedLimit::apply(const Costmap& costmap, const Pose
   ObstacleSpeedResult r;
   r.u = u;
   if (config_.robot_decel_mps2 <= 0.0 || costmap.cells() == 0) return r;
-  // The cells that could bind depend on how fast the result moves, which the projections may
-  // change: gather for the command's speed, and again should the result be faster (a
-  // projection never lengthens the command, but may turn it onto a faster-moving corner).
-  double radius_m = window_m(fastest_point_mps(u, config_.footprint), config_);
-  bool settled = false;
-  for (int round = 0; round < 3 && !settled; ++round) {
-    gather(costmap, robot, radius_m, config_, limits_, r);
-    r.u = solve(limits_, u);
-    const double needed_m = window_m(fastest_point_mps(r.u, config_.footprint), config_);
-    settled = needed_m <= radius_m;
-    radius_m = needed_m;
-  }
-  if (!settled) r.u = Twist{};  // not seen to settle: standing still meets every limit
+  // Only cells the command could reach before stopping can bind it; the result moves no point
+  // faster than the command does (each component only shrinks), so the command's reach is it.
+  gather(costmap, robot, window_m(fastest_point_mps(u, config_.footprint), config_), config_,
+         limits_, r);
+  r.u = solve(limits_, u);
   r.limited = r.u.vx != u.vx || r.u.vy != u.vy || r.u.wz != u.wz;
   return r;
 }
