@@ -1,43 +1,27 @@
 #include "core/control/obstacle_speed.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <vector>
 
 namespace core {
 namespace {
-
-using Limit = ObstacleSpeedLimit::Limit;
-
-double dot(const std::array<double, 3>& a, const Twist& u) {
-  return a[0] * u.vx + a[1] * u.vy + a[2] * u.wz;
-}
 
 // The footprint's farthest point from the robot's centre (m).
 double reach_m(const Footprint& f) {
   return std::hypot(std::max(-f.x_min_m, f.x_max_m), std::max(-f.y_min_m, f.y_max_m));
 }
 
-// The fastest any point of the footprint moves under `u` (m/s).
-double fastest_point_mps(const Twist& u, const Footprint& f) {
-  return std::hypot(u.vx, u.vy) + std::abs(u.wz) * reach_m(f);
+// Whether the footprint grown by `grow_m` on every side covers p.
+bool covers(const Footprint& f, const Point2& p, double grow_m) {
+  return p.x_m >= f.x_min_m - grow_m && p.x_m <= f.x_max_m + grow_m &&
+         p.y_m >= f.y_min_m - grow_m && p.y_m <= f.y_max_m + grow_m;
 }
 
-// How far from the robot's centre an obstacle can bind a command whose points move at most
-// `speed_mps`: beyond it the gap exceeds that speed's stopping distance.
-double window_m(double speed_mps, const ObstacleSpeedConfig& c) {
-  const double stop_m =
-      speed_mps * c.reaction_time_s + speed_mps * speed_mps / (2.0 * c.robot_decel_mps2);
-  return reach_m(c.footprint) + c.margin_m + stop_m + 1e-6;
-}
-
-// The obstacle cells within `radius_m` of the robot's centre, as limits on the command.
-void gather(const Costmap& map, const Pose2& robot, double radius_m, const ObstacleSpeedConfig& c,
-            std::vector<Limit>& out, ObstacleSpeedResult& r) {
+// The obstacle cells within `radius_m` of the robot's centre that the footprint grown by
+// `grow_m` does not cover now, in base_link.
+void gather(const Costmap& map, const Pose2& robot, double radius_m, const Footprint& f,
+            double grow_m, std::vector<Point2>& out) {
   out.clear();
-  r.obstacle_cells_looked = 0;
-  r.nearest_gap_m = 1e9;
   const double res = map.resolution();
   const auto cell_of = [&](double v, double origin) {
     return static_cast<int>(std::floor((v - origin) / res));
@@ -54,88 +38,77 @@ void gather(const Costmap& map, const Pose2& robot, double radius_m, const Obsta
       const double y = map.origin_y() + (j + 0.5) * res;
       if (std::hypot(x - robot.x_m, y - robot.y_m) > radius_m) continue;
       const Point2 p = odom_in_base.apply({x, y});
-      const Point2 q = c.footprint.nearest(p);
-      double nx = p.x_m - q.x_m;
-      double ny = p.y_m - q.y_m;
-      double gap_m = std::hypot(nx, ny);
-      Point2 at = q;
-      if (gap_m < 1e-9) {  // inside the footprint: already touching; away from the centre only
-        const double d = std::hypot(p.x_m, p.y_m);
-        nx = d > 1e-9 ? p.x_m : 1.0;
-        ny = d > 1e-9 ? p.y_m : 0.0;
-        gap_m = 0.0;
-        at = p;
-      }
-      const double norm = std::hypot(nx, ny);
-      nx /= norm;
-      ny /= norm;
-      ++r.obstacle_cells_looked;
-      r.nearest_gap_m = std::min(r.nearest_gap_m, gap_m);
-      // n . (v + w x r), w x r = (-w r_y, w r_x).
-      out.push_back({{nx, ny, at.x_m * ny - at.y_m * nx}, max_approach_speed_mps(gap_m, c)});
+      if (!covers(f, p, grow_m)) out.push_back(p);
     }
   }
-}
-
-// Within [0, u] component by component: the limit slows or stops each part of the command, never
-// adds motion (nor reverses it) the plan and the person's limits did not ask for.
-Twist toward_zero_of(const Twist& v, const Twist& u) {
-  auto within = [](double x, double bound) {
-    return bound >= 0.0 ? std::clamp(x, 0.0, bound) : std::clamp(x, bound, 0.0);
-  };
-  return Twist{within(v.vx, u.vx), within(v.vy, u.vy), within(v.wz, u.wz)};
-}
-
-Twist solve(const std::vector<Limit>& limits, const Twist& u) {
-  // Onto each broken limit in turn, then back into [0, u] (both convex, both hold zero): a few
-  // sweeps. Near a wall the limits of neighbouring cells differ little and the first sweep meets
-  // nearly all of them; what it keeps is the motion the limits do not mind (along a wall).
-  Twist v = u;
-  for (int sweep = 0; sweep < 4; ++sweep) {
-    bool broken = false;
-    for (const Limit& l : limits) {
-      const double over = dot(l.a, v) - l.s;
-      if (over <= 0.0) continue;
-      broken = true;
-      const double k = over / (l.a[0] * l.a[0] + l.a[1] * l.a[1] + l.a[2] * l.a[2]);
-      v = toward_zero_of(Twist{v.vx - k * l.a[0], v.vy - k * l.a[1], v.wz - k * l.a[2]}, u);
-    }
-    if (!broken) break;
-  }
-  // Then toward zero until every limit holds (each is met by the zero command).
-  double scale = 1.0;
-  for (const Limit& l : limits) {
-    const double along = dot(l.a, v);
-    if (along > l.s) scale = std::min(scale, l.s / along);
-  }
-  if (scale < 1.0) {
-    scale *= 1.0 - 1e-12;  // the product's rounding must not leave it a hair over
-    v = Twist{v.vx * scale, v.vy * scale, v.wz * scale};
-  }
-  return v;
 }
 
 }  // namespace
 
-double max_approach_speed_mps(double gap_m, const ObstacleSpeedConfig& c) {
-  const double room_m = gap_m - c.margin_m;
+double max_approach_speed_mps(double travel_m, const ObstacleSpeedConfig& c) {
+  const double room_m = travel_m - c.margin_m;
   if (c.robot_decel_mps2 <= 0.0 || room_m <= 0.0) return 0.0;
   const double a = c.robot_decel_mps2;
   const double t = c.reaction_time_s;
   return a * (std::sqrt(t * t + 2.0 * room_m / a) - t);
 }
 
+Pose2 pose_after(const Twist& u, double time_s) {
+  const double turn = u.wz * time_s;
+  if (std::abs(turn) < 1e-9) return Pose2{u.vx * time_s, u.vy * time_s, turn};
+  // The body velocity turned by w tau, integrated over tau in [0, t].
+  const double s = std::sin(turn);
+  const double one_minus_c = 1.0 - std::cos(turn);
+  return Pose2{(u.vx * s - u.vy * one_minus_c) / u.wz, (u.vx * one_minus_c + u.vy * s) / u.wz,
+               turn};
+}
+
+double fastest_point_mps(const Twist& u, const Footprint& f) {
+  return std::hypot(u.vx, u.vy) + std::abs(u.wz) * reach_m(f);
+}
+
 ObstacleSpeedResult ObstacleSpeedLimit::apply(const Costmap& costmap, const Pose2& robot,
                                               const Twist& u) {
   ObstacleSpeedResult r;
   r.u = u;
-  if (config_.robot_decel_mps2 <= 0.0 || costmap.cells() == 0) return r;
-  // Only cells the command could reach before stopping can bind it; the result moves no point
-  // faster than the command does (each component only shrinks), so the command's reach is it.
-  gather(costmap, robot, window_m(fastest_point_mps(u, config_.footprint), config_), config_,
-         limits_, r);
-  r.u = solve(limits_, u);
-  r.limited = r.u.vx != u.vx || r.u.vy != u.vy || r.u.wz != u.wz;
+  const ObstacleSpeedConfig& c = config_;
+  const double speed = fastest_point_mps(u, c.footprint);
+  if (c.robot_decel_mps2 <= 0.0 || costmap.cells() == 0 || speed < 1e-9) return r;
+  // The fastest point's travel to a stop from u, and the margin beyond: only cells within that
+  // (plus the footprint's reach) of the centre can be covered on the way.
+  const double horizon_m =
+      speed * c.reaction_time_s + speed * speed / (2.0 * c.robot_decel_mps2) + c.margin_m;
+  // Between two poses sweep_step_m apart no footprint point moves farther than that, so a cell
+  // the footprint covers at any moment between them lies within half of it of the footprint at
+  // one of them: the poses are checked with the footprint grown by half a step.
+  const double grow_m = 0.5 * c.sweep_step_m;
+  gather(costmap, robot, reach_m(c.footprint) + grow_m + horizon_m + 1e-6, c.footprint, grow_m,
+         cells_);
+  r.obstacle_cells_looked = static_cast<int>(cells_.size());
+  if (cells_.empty()) return r;
+  // Along the arc, every sweep_step_m of the fastest point's travel, the last pose that covers
+  // no cell.
+  const int steps = static_cast<int>(std::ceil(horizon_m / c.sweep_step_m));
+  double free_m = horizon_m;
+  bool hit = false;
+  for (int i = 1; i <= steps && !hit; ++i) {
+    const double travel_m = std::min(i * c.sweep_step_m, horizon_m);
+    const Pose2 base_in_start = pose_after(u, travel_m / speed).inverse();
+    for (const Point2& p : cells_) {
+      if (covers(c.footprint, base_in_start.apply(p), grow_m)) {
+        hit = true;
+        free_m = (i - 1) * c.sweep_step_m;
+        break;
+      }
+    }
+  }
+  r.free_travel_m = hit ? free_m : 1e9;
+  if (!hit) return r;
+  r.scale = std::min(1.0, max_approach_speed_mps(free_m, c) / speed);
+  if (r.scale < 1.0) {
+    r.u = Twist{u.vx * r.scale, u.vy * r.scale, u.wz * r.scale};
+    r.limited = true;
+  }
   return r;
 }
 

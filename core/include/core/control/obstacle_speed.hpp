@@ -1,25 +1,24 @@
 #pragma once
-// Speed and separation toward obstacles (after PX4's collision prevention and ISO/TS 15066's
-// SSM, as closing_speed.hpp does for the person): the last stage before the acceleration limits,
-// so that nothing upstream -- the plan, the barrier's repair pushing away from the person, the
-// closing-speed limit -- drives the footprint into an obstacle faster than it can stop.
-//   for every obstacle cell o of the costmap near the robot (base_link):
-//   gap D: the distance from the footprint (a box) to o's centre, less `margin_m`;
-//   n: the unit direction from the footprint's nearest point r to o;
-//   v_o: that point's velocity toward o, n . (v + w x r), linear in the command (vx, vy, wz);
-//   limit: v_o t_r + v_o^2 / (2 a_r) <= D (reaction, then braking at a_r), i.e.
-//          v_o <= a_r (sqrt(t_r^2 + 2 D / a_r) - t_r).
-// Every limit is >= 0, so standing still meets them all and motion away from an obstacle is
-// never limited: a robot already at an obstacle may leave it. Each component of the command is
-// only ever reduced toward zero (no motion is added, not even away from the wall: the person's
-// limits upstream must keep holding). The command is moved onto the limits it breaks one at a
-// time and back within [0, u] (a few sweeps: it keeps the motion along a wall, where scaling
-// would stop it), then scaled toward zero until every limit holds exactly. Why it exists: in the
-// dead-end corridors the barrier's repair and the plan's sidestep round a person walking back at
-// the robot drove it into the corridor's wall (docs/EVALUATION.md, thirty-third session). Obstacles
-// are what the lidar sees, pedestrians included (as if they stood still); the followed person is
-// masked out of the costmap (closing_speed.hpp is theirs).
-#include <array>
+// Speed and separation toward obstacles (ISO/TS 15066's SSM, as closing_speed.hpp is for the
+// person; Nav2's collision monitor's "approach" model): the controller's last stage before the
+// acceleration limits, so that nothing upstream -- the plan, the barrier's repair pushing away
+// from the person, the closing-speed limit -- drives the footprint into an obstacle it could not
+// stop short of.
+//   The command u (vx, vy, wz) held for the reaction time t_r, then braked to a stop with every
+//   component in proportion (the same arc, the fastest footprint point decelerating at a_r),
+//   sweeps the footprint along one arc. The command is scaled to k u, 0 <= k <= 1, the largest
+//   whose sweep, plus margin_m more of the fastest point's travel, covers no obstacle cell:
+//   with d the fastest point's travel along the arc to the first pose that would cover one,
+//   k |u|_fp t_r + (k |u|_fp)^2 / (2 a_r) = d - margin_m  (|u|_fp: the fastest point's speed).
+// Along a wall, and away from an obstacle, the sweep covers nothing: the command is left alone;
+// toward one it is slowed to what stops short of it, and the arc (direction, turning) is kept.
+// Cells the footprint already covers are not counted (a robot touching an obstacle may leave).
+// The arc is checked at poses sweep_step_m of travel apart with the footprint grown by half a
+// step, so no contact between two poses is missed (the limit is that much more cautious).
+// Why it exists: in the dead-end corridors the barrier's repair and the plan's sidestep round a
+// person walking back at the robot drove it into the corridor's wall (docs/EVALUATION.md,
+// thirty-third session). Obstacles are what the lidar sees, pedestrians included (as if they
+// stood still); the followed person is masked out of the costmap (closing_speed.hpp is theirs).
 #include <vector>
 
 #include "core/control/closing_speed.hpp"
@@ -32,28 +31,30 @@ namespace core {
 struct ObstacleSpeedConfig {
   double robot_decel_mps2 = 0;    // a_r; 0 = off
   double reaction_time_s = 0.05;  // t_r: command latency and the control period
-  double margin_m = 0.05;         // gap left between the footprint and an obstacle cell's centre
+  double margin_m = 0.05;         // the fastest point's travel left before a stop would touch
+  double sweep_step_m = 0.02;     // the fastest point's travel between the poses checked
   Footprint footprint;
 };
 
 struct ObstacleSpeedResult {
   Twist u;
-  bool limited = false;           // the command was changed
-  double nearest_gap_m = 1e9;     // footprint to the nearest obstacle cell looked at
+  bool limited = false;           // the command was scaled down
+  double scale = 1.0;             // k
+  double free_travel_m = 1e9;     // d: the fastest point's travel before the sweep would touch
   int obstacle_cells_looked = 0;  // obstacle cells within reach of the command
 };
 
-// The largest speed toward an obstacle `gap_m` away that still stops `margin_m` short of it.
-double max_approach_speed_mps(double gap_m, const ObstacleSpeedConfig& c);
+// The largest speed that stops, after the reaction time, `margin_m` short of `travel_m` (>= 0).
+double max_approach_speed_mps(double travel_m, const ObstacleSpeedConfig& c);
+
+// The pose (in the frame of the start) after `u` held for `time_s`: the exact arc.
+Pose2 pose_after(const Twist& u, double time_s);
+
+// The fastest any point of `f` moves under `u` (m/s).
+double fastest_point_mps(const Twist& u, const Footprint& f);
 
 class ObstacleSpeedLimit {
  public:
-  // One obstacle cell's limit on the command: a . (vx, vy, wz) <= s.
-  struct Limit {
-    std::array<double, 3> a;
-    double s;
-  };
-
   ObstacleSpeedLimit() = default;
   explicit ObstacleSpeedLimit(const ObstacleSpeedConfig& config) : config_(config) {}
   [[nodiscard]] const ObstacleSpeedConfig& config() const { return config_; }
@@ -64,7 +65,7 @@ class ObstacleSpeedLimit {
 
  private:
   ObstacleSpeedConfig config_;
-  std::vector<Limit> limits_;  // reused
+  std::vector<Point2> cells_;  // obstacle cells in reach, base_link (reused)
 };
 
 }  // namespace core
