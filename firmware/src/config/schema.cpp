@@ -1048,11 +1048,12 @@ std::vector<FieldSpec> build() {
        "m/s^2",
        "Speed and separation toward obstacles (the costmap's obstacle cells, pedestrians "
        "included, as if standing): the last stage of the controller's command, after the "
-       "barrier's repair and closing_speed.*, so that nothing drives the footprint toward an "
-       "obstacle faster than it can stop from at this deceleration, after "
-       "obstacle_speed.reaction_time_s, obstacle_speed.margin_m short of it. Changes only the "
-       "motion toward obstacles (motion along a wall is kept), never adds motion toward one. "
-       "0: off (the paper's controller).",
+       "barrier's repair and closing_speed.*. The command, held for obstacle_speed.reaction_time_s "
+       "and then braked at this deceleration along its own arc, must stop with "
+       "obstacle_speed.margin_m of travel to spare before the footprint (costmap.footprint_*) "
+       "would cover an obstacle cell; a command that would not is scaled down until it does "
+       "(direction and turning kept). Along a wall nothing is limited. 0: off (the paper's "
+       "controller).",
        FIELD(obstacle_speed.robot_decel_mps2),
        0.0,
        10.0,
@@ -1066,8 +1067,8 @@ std::vector<FieldSpec> build() {
        {}},
       {"obstacle_speed.margin_m",
        "m",
-       "Gap left between the robot's footprint (costmap.footprint_*) and an obstacle cell's "
-       "centre after a stop.",
+       "Travel of the footprint's fastest point left between a stop and the first obstacle cell "
+       "it would cover.",
        FIELD(obstacle_speed.margin_m),
        0.0,
        1.0,
