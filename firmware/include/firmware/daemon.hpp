@@ -116,13 +116,13 @@ struct ControlStatus {
   double min_cost = 0;             // the best rollout's cost
   core::MppiCostTerms best_cost;   // ... by term (why the robot leaves q^d: collision, barrier)
   double effective_samples = 0;
-  uint64_t runs = 0;            // MPPI steps so far
-  uint64_t failures = 0;        // MPPI steps that failed
-  uint64_t repairs = 0;         // first controls the QP repair changed
-  uint64_t closing_limits = 0;  // commands slowed toward the person (closing_speed.*)
-  uint64_t obstacle_limits = 0;  // commands changed toward an obstacle (obstacle_speed.*)
-  uint64_t guided_plans = 0;    // steps where a structured sample became the plan (guide_samples)
-  uint64_t paths_planned = 0;   // steps with a costmap path round an obstacle (path_guide)
+  uint64_t runs = 0;             // MPPI steps so far
+  uint64_t failures = 0;         // MPPI steps that failed
+  uint64_t repairs = 0;          // first controls the QP repair changed
+  uint64_t closing_limits = 0;   // commands slowed toward the person (closing_speed.*)
+  uint64_t obstacle_limits = 0;  // slowed to stop short of an obstacle (obstacle_speed.*)
+  uint64_t guided_plans = 0;     // steps where a structured sample became the plan (guide_samples)
+  uint64_t paths_planned = 0;    // steps with a costmap path round an obstacle (path_guide)
   uint64_t path_guided_plans = 0;   // ... where the path sample became the plan
   uint64_t orbits_planned = 0;      // steps with q^d across the person's ellipse (orbit_guide)
   uint64_t orbit_guided_plans = 0;  // ... where an orbit sample became the plan

@@ -142,7 +142,7 @@ struct MppiOutput {
   bool repaired = false;
   bool repair_feasible = true;
   bool closing_limited = false;   // slowed toward the person (ClosingSpeedConfig)
-  bool obstacle_limited = false;  // changed toward an obstacle (ObstacleSpeedConfig)
+  bool obstacle_limited = false;  // slowed to stop short of an obstacle (ObstacleSpeedConfig)
   bool guided = false;            // a structured sample beat every random one and became the plan
   bool path_planned = false;     // an obstacle lay on the line to q^d and a path round it was found
   bool path_guided = false;      // ... and its sample became the plan

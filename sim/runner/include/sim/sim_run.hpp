@@ -53,7 +53,7 @@ struct ControllerCounts {
   uint64_t path_guided_plans = 0;   // ... and following it was the plan
   uint64_t orbits_planned = 0;      // q^d across the person: orbit samples ran (orbit_guide)
   uint64_t orbit_guided_plans = 0;  // ... and one was the plan
-  uint64_t obstacle_limits = 0;     // commands the obstacle speed limit changed
+  uint64_t obstacle_limits = 0;     // commands the obstacle speed limit slowed
 };
 
 struct SimRunResult {
