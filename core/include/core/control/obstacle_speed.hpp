@@ -12,9 +12,11 @@
 //   k |u|_fp t_r + (k |u|_fp)^2 / (2 a_r) = d - margin_m  (|u|_fp: the fastest point's speed).
 // Along a wall, and away from an obstacle, the sweep covers nothing: the command is left alone;
 // toward one it is slowed to what stops short of it, and the arc (direction, turning) is kept.
-// Cells the footprint already covers are not counted (a robot touching an obstacle may leave).
 // The arc is checked at poses sweep_step_m of travel apart with the footprint grown by half a
-// step, so no contact between two poses is missed (the limit is that much more cautious).
+// step, so no contact between two poses is missed (the limit is that much more cautious); cells
+// that grown footprint already covers are not counted (a robot touching an obstacle may leave).
+// Where an obstacle first appears inside the stopping distance, the acceleration limits after
+// this stage keep the command from dropping faster than the base can brake.
 // Why it exists: in the dead-end corridors the barrier's repair and the plan's sidestep round a
 // person walking back at the robot drove it into the corridor's wall (docs/EVALUATION.md,
 // thirty-third session). Obstacles are what the lidar sees, pedestrians included (as if they
