@@ -169,22 +169,18 @@ core::MppiConfig mppi_config(const DaemonConfig& cfg) {
   c.guide_samples = m.guide_samples;
   c.path_guide = m.path_guide;
   c.orbit_guide = m.orbit_guide;
+  c.closing = closing_speed_config(cfg);
   // The footprint can touch an obstacle closer than its circumscribed radius.
-  const double footprint_x_m =
-      std::max(std::abs(cfg.costmap.footprint_x_min_m), std::abs(cfg.costmap.footprint_x_max_m));
-  const double footprint_y_m =
-      std::max(std::abs(cfg.costmap.footprint_y_min_m), std::abs(cfg.costmap.footprint_y_max_m));
   c.contact_threshold = core::cost_at_distance(
       core::CostmapConfig{cfg.costmap.inscribed_radius_m, cfg.costmap.inflation_radius_m,
                           cfg.costmap.cost_scaling_per_m},
-      std::hypot(footprint_x_m, footprint_y_m));
+      c.closing.footprint.circumscribed_radius_m());
   c.dcbf_delta = cfg.dcbf.delta;
   c.c_safe = cfg.dcbf.c_safe;
   c.ellipse = core::Ellipse{cfg.interactive_space.ellipse_a_m, cfg.interactive_space.ellipse_b_m};
   c.limits =
       core::TwistLimits{cfg.limits.vx_max_mps, cfg.limits.vy_max_mps, cfg.limits.wz_max_radps};
   c.reverse_speed_max_mps = m.reverse_speed_max_mps;
-  c.closing = closing_speed_config(cfg);
   c.obstacle_speed.robot_decel_mps2 = cfg.obstacle_speed.robot_decel_mps2;
   c.obstacle_speed.reaction_time_s = cfg.obstacle_speed.reaction_time_s;
   c.obstacle_speed.margin_m = cfg.obstacle_speed.margin_m;

@@ -6,17 +6,6 @@
 namespace core {
 namespace {
 
-// The footprint's farthest point from the robot's centre (m).
-double reach_m(const Footprint& f) {
-  return std::hypot(std::max(-f.x_min_m, f.x_max_m), std::max(-f.y_min_m, f.y_max_m));
-}
-
-// Whether the footprint grown by `grow_m` on every side covers p.
-bool covers(const Footprint& f, const Point2& p, double grow_m) {
-  return p.x_m >= f.x_min_m - grow_m && p.x_m <= f.x_max_m + grow_m &&
-         p.y_m >= f.y_min_m - grow_m && p.y_m <= f.y_max_m + grow_m;
-}
-
 // The obstacle cells within `radius_m` of the robot's centre that the footprint grown by
 // `grow_m` does not cover now, in base_link.
 void gather(const Costmap& map, const Pose2& robot, double radius_m, const Footprint& f,
@@ -38,7 +27,7 @@ void gather(const Costmap& map, const Pose2& robot, double radius_m, const Footp
       const double y = map.origin_y() + (j + 0.5) * res;
       if (std::hypot(x - robot.x_m, y - robot.y_m) > radius_m) continue;
       const Point2 p = odom_in_base.apply({x, y});
-      if (!covers(f, p, grow_m)) out.push_back(p);
+      if (!f.covers(p, grow_m)) out.push_back(p);
     }
   }
 }
@@ -64,7 +53,7 @@ Pose2 pose_after(const Twist& u, double time_s) {
 }
 
 double fastest_point_mps(const Twist& u, const Footprint& f) {
-  return std::hypot(u.vx, u.vy) + std::abs(u.wz) * reach_m(f);
+  return std::hypot(u.vx, u.vy) + std::abs(u.wz) * f.circumscribed_radius_m();
 }
 
 ObstacleSpeedResult ObstacleSpeedLimit::apply(const Costmap& costmap, const Pose2& robot,
@@ -72,8 +61,9 @@ ObstacleSpeedResult ObstacleSpeedLimit::apply(const Costmap& costmap, const Pose
   ObstacleSpeedResult r;
   r.u = u;
   const ObstacleSpeedConfig& c = config_;
+  if (c.robot_decel_mps2 <= 0.0 || costmap.cells() == 0) return r;  // off: nothing computed
   const double speed = fastest_point_mps(u, c.footprint);
-  if (c.robot_decel_mps2 <= 0.0 || costmap.cells() == 0 || speed < 1e-9) return r;
+  if (speed < 1e-9) return r;
   // The fastest point's travel to a stop from u, and the margin beyond: only cells within that
   // (plus the footprint's reach) of the centre can be covered on the way.
   const double horizon_m =
@@ -82,8 +72,8 @@ ObstacleSpeedResult ObstacleSpeedLimit::apply(const Costmap& costmap, const Pose
   // the footprint covers at any moment between them lies within half of it of the footprint at
   // one of them: the poses are checked with the footprint grown by half a step.
   const double grow_m = 0.5 * c.sweep_step_m;
-  gather(costmap, robot, reach_m(c.footprint) + grow_m + horizon_m + 1e-6, c.footprint, grow_m,
-         cells_);
+  gather(costmap, robot, c.footprint.circumscribed_radius_m() + grow_m + horizon_m + 1e-6,
+         c.footprint, grow_m, cells_);
   r.obstacle_cells_looked = static_cast<int>(cells_.size());
   if (cells_.empty()) return r;
   // Along the arc, every sweep_step_m of the fastest point's travel, the last pose that covers
@@ -95,7 +85,7 @@ ObstacleSpeedResult ObstacleSpeedLimit::apply(const Costmap& costmap, const Pose
     const double travel_m = std::min(i * c.sweep_step_m, horizon_m);
     const Pose2 base_in_start = pose_after(u, travel_m / speed).inverse();
     for (const Point2& p : cells_) {
-      if (covers(c.footprint, base_in_start.apply(p), grow_m)) {
+      if (c.footprint.covers(base_in_start.apply(p), grow_m)) {
         hit = true;
         free_m = (i - 1) * c.sweep_step_m;
         break;

@@ -218,3 +218,14 @@ TEST(ClosingSpeed, TheFollowStandoffIsWhereTheLimitLetsTheRobotKeepPace) {
   EXPECT_DOUBLE_EQ(core::follow_standoff_m({1.0, 0.0}, {0.0, 0.0}, c), 0.0);
   EXPECT_DOUBLE_EQ(core::follow_standoff_m({1.0, 0.0}, walking, ClosingSpeedConfig{}), 0.0);
 }
+
+TEST(Footprint, CoversItsBoxGrownAndItsCornerIsTheCircumscribedRadius) {
+  const core::Footprint f;  // x -0.35 .. 0.35, y -0.30 .. 0.30
+  EXPECT_TRUE(f.covers({0.35, -0.30}));
+  EXPECT_FALSE(f.covers({0.36, 0.0}));
+  EXPECT_TRUE(f.covers({0.36, 0.0}, 0.01 + 1e-12));
+  EXPECT_FALSE(f.covers({0.0, -0.32}, 0.01));
+  EXPECT_DOUBLE_EQ(f.circumscribed_radius_m(), std::hypot(0.35, 0.30));
+  const core::Footprint off_centre{-0.2, 0.5, -0.1, 0.3};
+  EXPECT_DOUBLE_EQ(off_centre.circumscribed_radius_m(), std::hypot(0.5, 0.3));
+}

@@ -615,10 +615,6 @@ core::ObstacleSpeedConfig obstacle_speed_on() {
 // bookkeeping.
 double first_touch_m(const core::Costmap& map, const Pose2& robot, const Twist& u,
                      const core::Footprint& f, double grow_m = 0.0) {
-  auto covers = [&](const core::Point2& p) {
-    return p.x_m >= f.x_min_m - grow_m && p.x_m <= f.x_max_m + grow_m &&
-           p.y_m >= f.y_min_m - grow_m && p.y_m <= f.y_max_m + grow_m;
-  };
   std::vector<core::Point2> cells;
   const Pose2 odom_in_base = robot.inverse();
   for (int j = 0; j < map.cells(); ++j) {
@@ -626,14 +622,14 @@ double first_touch_m(const core::Costmap& map, const Pose2& robot, const Twist& 
       if (!map.obstacle(i, j)) continue;
       const core::Point2 p = odom_in_base.apply({map.origin_x() + (i + 0.5) * map.resolution(),
                                                  map.origin_y() + (j + 0.5) * map.resolution()});
-      if (std::hypot(p.x_m, p.y_m) < 4.0 && !covers(p)) cells.push_back(p);
+      if (std::hypot(p.x_m, p.y_m) < 4.0 && !f.covers(p, grow_m)) cells.push_back(p);
     }
   }
   const double speed = core::fastest_point_mps(u, f);
   for (int k = 1; k <= 4000; ++k) {
     const Pose2 back = core::pose_after(u, 0.001 * k / speed).inverse();
     for (const auto& p : cells) {
-      if (covers(back.apply(p))) return 0.001 * k;
+      if (f.covers(back.apply(p), grow_m)) return 0.001 * k;
     }
   }
   return std::numeric_limits<double>::infinity();

@@ -21,6 +21,7 @@
 // on the ellipse's edge, a robot catching up at 1.5 m/s met the person's turn faster than its
 // 1.5 m/s^2 brakes could stop in the 0.2-0.4 m left between the bodies (docs/EVALUATION.md).
 #include <algorithm>
+#include <cmath>
 
 #include "core/control/dcbf_repair.hpp"
 #include "core/geometry/pose2.hpp"
@@ -32,6 +33,16 @@ struct Footprint {
   // The box's point nearest `p` (base_link; `p` itself when inside).
   [[nodiscard]] Point2 nearest(const Point2& p) const {
     return {std::clamp(p.x_m, x_min_m, x_max_m), std::clamp(p.y_m, y_min_m, y_max_m)};
+  }
+  // Whether the box grown by `grow_m` on every side covers `p` (base_link).
+  [[nodiscard]] bool covers(const Point2& p, double grow_m = 0.0) const {
+    return p.x_m >= x_min_m - grow_m && p.x_m <= x_max_m + grow_m && p.y_m >= y_min_m - grow_m &&
+           p.y_m <= y_max_m + grow_m;
+  }
+  // Its farthest point from base_link's origin (m): closer than this it can touch an obstacle.
+  [[nodiscard]] double circumscribed_radius_m() const {
+    return std::hypot(std::max(std::abs(x_min_m), std::abs(x_max_m)),
+                      std::max(std::abs(y_min_m), std::abs(y_max_m)));
   }
 };
 
