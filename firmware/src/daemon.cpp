@@ -184,6 +184,7 @@ core::MppiConfig mppi_config(const DaemonConfig& cfg) {
   c.obstacle_speed.robot_decel_mps2 = cfg.obstacle_speed.robot_decel_mps2;
   c.obstacle_speed.reaction_time_s = cfg.obstacle_speed.reaction_time_s;
   c.obstacle_speed.margin_m = cfg.obstacle_speed.margin_m;
+  c.obstacle_speed.settled_s = cfg.obstacle_speed.settled_s;
   c.obstacle_speed.footprint = c.closing.footprint;
   c.linear_accel_mps2 = cfg.limits.linear_accel_max_mps2;
   c.angular_accel_radps2 = cfg.limits.angular_accel_max_radps2;

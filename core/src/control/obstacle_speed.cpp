@@ -6,10 +6,10 @@
 namespace core {
 namespace {
 
-// The obstacle cells within `radius_m` of the robot's centre that the footprint grown by
-// `grow_m` does not cover now, in base_link.
-void gather(const Costmap& map, const Pose2& robot, double radius_m, const Footprint& f,
-            double grow_m, std::vector<Point2>& out) {
+// The obstacle cells at least `settled_s` old within `radius_m` of the robot's centre that the
+// footprint grown by `grow_m` does not cover now, in base_link.
+void gather(const Costmap& map, const Pose2& robot, double radius_m, double settled_s,
+            const Footprint& f, double grow_m, std::vector<Point2>& out) {
   out.clear();
   const double res = map.resolution();
   const auto cell_of = [&](double v, double origin) {
@@ -22,7 +22,7 @@ void gather(const Costmap& map, const Pose2& robot, double radius_m, const Footp
   const Pose2 odom_in_base = robot.inverse();
   for (int j = j0; j <= j1; ++j) {
     for (int i = i0; i <= i1; ++i) {
-      if (!map.obstacle(i, j)) continue;
+      if (!map.obstacle(i, j) || map.obstacle_age_s(i, j) < settled_s) continue;
       const double x = map.origin_x() + (i + 0.5) * res;
       const double y = map.origin_y() + (j + 0.5) * res;
       if (std::hypot(x - robot.x_m, y - robot.y_m) > radius_m) continue;
@@ -73,7 +73,7 @@ ObstacleSpeedResult ObstacleSpeedLimit::apply(const Costmap& costmap, const Pose
   // one of them: the poses are checked with the footprint grown by half a step.
   const double grow_m = 0.5 * c.sweep_step_m;
   gather(costmap, robot, c.footprint.circumscribed_radius_m() + grow_m + horizon_m + 1e-6,
-         c.footprint, grow_m, cells_);
+         c.settled_s, c.footprint, grow_m, cells_);
   r.obstacle_cells_looked = static_cast<int>(cells_.size());
   if (cells_.empty()) return r;
   // Along the arc, every sweep_step_m of the fastest point's travel, the last pose that covers

@@ -53,6 +53,7 @@ Costmap::Costmap(int cells, double resolution_m)
       obstacle_(cost_.size(), 0),
       dist2_(cost_.size(), kInf),
       row_(static_cast<size_t>(cells)),
+      row_age_(static_cast<size_t>(cells)),
       f_(static_cast<size_t>(cells)),
       g_(static_cast<size_t>(cells)),
       z_(static_cast<size_t>(cells) + 1),
@@ -74,12 +75,18 @@ void Costmap::build(const VoxelGrid& grid, const CostmapConfig& config, Nanos st
   const auto n = static_cast<size_t>(n_);
   for (int j = 0; j < n_; ++j) {
     grid.row(j, row_);
+    grid.row_occupied_for(j, stamp, row_age_);
     float* out = &dist2_[static_cast<size_t>(j) * n];
+    uint8_t* obstacle_out = &obstacle_[static_cast<size_t>(j) * n];
     size_t row_obstacles = 0;
     for (size_t i = 0; i < n; ++i) {
       const bool obstacle = row_[i] != 0;
       row_obstacles += obstacle ? 1U : 0U;
       f_[i] = obstacle ? 0.0f : kInf;
+      // Ages are whole 10 ms: the small addition keeps 1.0 s from rounding to 0.95.
+      const float steps =
+          std::min(row_age_[i] / static_cast<float>(kObstacleAgeStepS) + 1e-3f, 254.0f);
+      obstacle_out[i] = obstacle ? static_cast<uint8_t>(1 + static_cast<int>(steps)) : 0;
     }
     obstacles_ += row_obstacles;
     if (row_obstacles == 0) {
@@ -125,7 +132,6 @@ void Costmap::build(const VoxelGrid& grid, const CostmapConfig& config, Nanos st
     const float d2 = dist2_[c];
     // d2 holds an exact integer (a sum of squared cell offsets): truncation is exact.
     cost_[c] = d2 <= limit ? lut_[static_cast<size_t>(d2)] : 0;
-    obstacle_[c] = d2 == 0.0f ? 1 : 0;
   }
   build_quad_ranges();
 }

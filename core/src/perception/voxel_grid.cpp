@@ -20,6 +20,14 @@ uint16_t stamp_units(Nanos now) {
   return static_cast<uint16_t>((now.count() / 10'000'000) & 0xFFFF);  // 10 ms
 }
 
+// 10 ms units, wrapping after 497 days (differences are taken modulo 2^32); never the
+// "not occupied" mark itself.
+uint32_t since_units(Nanos now) {
+  const auto t =
+      static_cast<uint32_t>(static_cast<uint64_t>(now.count() / 10'000'000) & 0xFFFFFFFFU);
+  return t == 0xFFFFFFFFU ? t - 1 : t;
+}
+
 }  // namespace
 
 VoxelGrid::VoxelGrid(const VoxelGridConfig& config)
@@ -33,6 +41,7 @@ VoxelGrid::VoxelGrid(const VoxelGridConfig& config)
           64)),
       mask_(static_cast<size_t>(n_) * static_cast<size_t>(n_), 0),
       stamp_(mask_.size() * static_cast<size_t>(nz_), 0),
+      occupied_since_(mask_.size(), kNotOccupied),
       block_count_(static_cast<size_t>(n_ / kBlock) * static_cast<size_t>(n_ / kBlock), 0),
       traced_(1 << 17),
       depth_(static_cast<size_t>(kAzimuthBins) * kElevationBins, -1.0f),
@@ -64,6 +73,7 @@ size_t VoxelGrid::slot(int64_t cx, int64_t cy) const {
 
 void VoxelGrid::empty_column(size_t col) {
   set_column(col, 0);
+  occupied_since_[col] = kNotOccupied;
 }
 
 void VoxelGrid::recentre(double robot_x_m, double robot_y_m) {
@@ -72,6 +82,7 @@ void VoxelGrid::recentre(double robot_x_m, double robot_y_m) {
   if (!placed_ || std::abs(nx - ox_) >= n_ || std::abs(ny - oy_) >= n_) {
     std::fill(mask_.begin(), mask_.end(), 0);
     std::fill(block_count_.begin(), block_count_.end(), 0);
+    std::fill(occupied_since_.begin(), occupied_since_.end(), kNotOccupied);
     ox_ = nx;
     oy_ = ny;
     placed_ = true;
@@ -386,6 +397,19 @@ void VoxelGrid::insert(std::span<const Ray> rays, const Pose2& robot,
   }
   if (cfg_.clear_seen_through) clear_seen_through(rays, stamp);
   if (person) clear_person(*person);
+  update_occupied_since(now);
+}
+
+void VoxelGrid::update_occupied_since(Nanos now) {
+  const uint32_t t = since_units(now);
+  for (size_t col = 0; col < mask_.size(); ++col) {
+    uint32_t& since = occupied_since_[col];
+    if (mask_[col] == 0) {
+      since = kNotOccupied;
+    } else if (since == kNotOccupied) {
+      since = t;
+    }
+  }
 }
 
 // Where the tracked person stands, nothing else can: the voxels there are freed. The robot
@@ -633,6 +657,7 @@ void VoxelGrid::decay(Nanos now) {
       }
     }
     set_column(col, keep);
+    if (keep == 0) occupied_since_[col] = kNotOccupied;
   }
 }
 
@@ -650,6 +675,27 @@ void VoxelGrid::row(int j, std::span<uint64_t> out) const {
               out.begin() + static_cast<std::ptrdiff_t>(wrapped));
 }
 
+double VoxelGrid::occupied_for_s(int i, int j, Nanos now) const {
+  const uint32_t since = occupied_since_[slot(ox_ + i, oy_ + j)];
+  if (since == kNotOccupied) return 0.0;
+  // A `now` before the mark (a replay restarted) reads as just marked, not as 497 days.
+  return std::max(0, static_cast<int32_t>(since_units(now) - since)) * 0.01;
+}
+
+void VoxelGrid::row_occupied_for(int j, Nanos now, std::span<float> seconds) const {
+  const auto n = static_cast<size_t>(n_);
+  const size_t first = slot(ox_, oy_ + j);
+  const size_t row_start = first - first % n;
+  const uint32_t t = since_units(now);
+  for (size_t i = 0; i < n; ++i) {
+    const size_t col = (first % n) + i < n ? first + i : row_start + (first % n + i - n);
+    const uint32_t since = occupied_since_[col];
+    seconds[i] = since == kNotOccupied
+                     ? 0.0f
+                     : static_cast<float>(std::max(0, static_cast<int32_t>(t - since))) * 0.01f;
+  }
+}
+
 bool VoxelGrid::occupied(double x, double y, double z) const {
   const int64_t cx = static_cast<int64_t>(std::floor(x / res_));
   const int64_t cy = static_cast<int64_t>(std::floor(y / res_));
@@ -662,6 +708,7 @@ bool VoxelGrid::occupied(double x, double y, double z) const {
 
 size_t VoxelGrid::memory_bytes() const {
   return mask_.capacity() * sizeof(uint64_t) + stamp_.capacity() * sizeof(uint16_t) +
+         occupied_since_.capacity() * sizeof(uint32_t) +
          block_count_.capacity() * sizeof(uint16_t) + traced_.capacity() * sizeof(TracedSlot) +
          depth_.capacity() * sizeof(float) + azimuth_origin_.capacity() * sizeof(Point3) +
          azimuth_seen_.capacity();

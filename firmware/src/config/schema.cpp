@@ -1046,8 +1046,8 @@ std::vector<FieldSpec> build() {
        {}},
       {"obstacle_speed.robot_decel_mps2",
        "m/s^2",
-       "Speed and separation toward obstacles (the costmap's obstacle cells, pedestrians "
-       "included, as if standing): the last stage of the controller's command, after the "
+       "Speed and separation toward obstacles (the costmap's obstacle cells occupied for at "
+       "least obstacle_speed.settled_s): the last stage of the controller's command, after the "
        "barrier's repair and closing_speed.*. The command, held for obstacle_speed.reaction_time_s "
        "and then braked at this deceleration along its own arc, must stop with "
        "obstacle_speed.margin_m of travel to spare before the footprint (costmap.footprint_*) "
@@ -1072,6 +1072,16 @@ std::vector<FieldSpec> build() {
        FIELD(obstacle_speed.margin_m),
        0.0,
        1.0,
+       {}},
+      {"obstacle_speed.settled_s",
+       "s",
+       "An obstacle cell counts once it has held an obstacle this long: walls and standing "
+       "people do, a walking pedestrian's cells (left within a fraction of a second) do not "
+       "(the plan's collision cost keeps them). 0: every obstacle cell. A wall that comes into "
+       "view within reach is not limited for this long.",
+       FIELD(obstacle_speed.settled_s),
+       0.0,
+       10.0,
        {}},
   };
 }

@@ -132,7 +132,8 @@ core::Costmap wall_map(double y_min_m = -0.6, double y_max_m = 0.6, double top_x
     rays.push_back({{1.5 + 0.02 * k, -3.0, 3.0}, {1.5 + 0.02 * k, y_max_m, 0.5}});
   g.insert(rays, Pose2{30, 30, 0}, std::nullopt, 1s);
   core::Costmap m;
-  m.build(g, core::CostmapConfig{}, 1s);
+  // Ten seconds after the scan: walls long settled (ObstacleSpeedConfig::settled_s).
+  m.build(g, core::CostmapConfig{}, 11s);
   return m;
 }
 
@@ -768,4 +769,66 @@ TEST(ObstacleSpeed, EveryResultStopsShortAndOnlyScalesForRandomPosesAndCommands)
   }
   EXPECT_GT(limited, 30) << "the poses are near enough the walls to test anything";
   EXPECT_LT(limited, 270) << "and not all of them";
+}
+
+// What the limit counts as an obstacle: cells that have held one for settled_s. Through the
+// real perception path (rays into the voxel grid, 10 scans a second, the costmap built after
+// each), a person standing 0.7 m ahead of the robot's front and one who walks across its path
+// at 1.3 m/s and is just as far ahead at the last scan: the standing one holds a robot driving
+// at them at 1.5 m/s, the walking one does not (their cells are younger than settled_s; with
+// settled_s 0, as before this existed, they do). The wall behind, seen as long, is limited.
+TEST(ObstacleSpeed, ASettledObstacleIsLimitedAPedestrianWalkingAcrossIsNot) {
+  const double person_x = 1.3;  // centre; 0.25 m radius
+  const auto run = [&](bool walking) {
+    core::VoxelGridConfig gc;
+    gc.size_xy_m = 10.0;
+    core::VoxelGrid g(gc);
+    g.recentre(0, 0);
+    core::Costmap map;
+    std::vector<core::Ray> rays;
+    for (int k = 0; k <= 12; ++k) {
+      const double person_y = walking ? -1.56 + 0.13 * k : 0.0;
+      rays.clear();
+      for (int n = -300; n <= 300; ++n) {  // azimuths 0.004 rad apart, +-1.2 rad
+        const double dx = std::cos(0.004 * n), dy = std::sin(0.004 * n);
+        double t = 4.0 / dx;  // the wall at x = 4 m
+        // The nearer root of |t d - c| = 0.25 for the person's circle c.
+        const double b = dx * person_x + dy * person_y;
+        const double disc = b * b - (person_x * person_x + person_y * person_y - 0.0625);
+        if (disc >= 0.0) t = std::min(t, b - std::sqrt(disc));
+        rays.push_back({{0, 0, 0.7}, {t * dx, t * dy, 0.7}});
+      }
+      const Nanos now = 1s + 100ms * k;
+      g.insert(rays, Pose2{}, std::nullopt, now);
+      g.decay(now);
+      map.build(g, core::CostmapConfig{}, now);
+    }
+    return map;
+  };
+  const core::Costmap standing = run(false);
+  const core::Costmap walking = run(true);
+  double walking_oldest_s = 0.0;
+  int walking_cells = 0;
+  for (int j = 0; j < walking.cells(); ++j) {
+    for (int i = 0; i < walking.cells(); ++i) {
+      const double x = walking.origin_x() + (i + 0.5) * walking.resolution();
+      const double y = walking.origin_y() + (j + 0.5) * walking.resolution();
+      if (!walking.obstacle(i, j) || std::hypot(x - person_x, y) > 0.5) continue;
+      walking_oldest_s = std::max(walking_oldest_s, walking.obstacle_age_s(i, j));
+      ++walking_cells;
+    }
+  }
+  ASSERT_GT(walking_cells, 5) << "the walking person is in the map";
+  EXPECT_LT(walking_oldest_s, 0.5);
+
+  core::ObstacleSpeedLimit limit(obstacle_speed_on());  // settled_s 1 s: the default
+  const Twist at_them{1.5, 0.0, 0.0};
+  EXPECT_TRUE(limit.apply(standing, Pose2{}, at_them).limited);
+  EXPECT_FALSE(limit.apply(walking, Pose2{}, at_them).limited) << "a passer-by is not a wall";
+  const Pose2 near_wall{2.8, 0.0, 0.0};  // its front 0.85 m from the wall
+  EXPECT_TRUE(limit.apply(walking, near_wall, at_them).limited) << "the wall, seen 1.2 s, is";
+  auto every_cell = obstacle_speed_on();
+  every_cell.settled_s = 0.0;
+  core::ObstacleSpeedLimit unfiltered(every_cell);
+  EXPECT_TRUE(unfiltered.apply(walking, Pose2{}, at_them).limited);
 }

@@ -194,16 +194,75 @@ TEST(VoxelGrid, RowsAreTheWindowsColumnsWhereverTheStorageWraps) {
     rays.push_back(ray_to(u(rng), u(rng), 0.5));
   g.insert(rays, {}, std::nullopt, 1s);
   g.recentre(1.35, -2.05);  // wraps the storage in both directions
+  // Half as many again a second later: columns of two ages.
+  rays.resize(150);
+  for (auto& r : rays)
+    r = ray_to(1.35 + u(rng), -2.05 + u(rng), 0.5, Point3{1.35, -2.05, 3.0});
+  g.insert(rays, {}, std::nullopt, 2s);
   std::vector<uint64_t> row(static_cast<size_t>(g.cells_xy()));
+  std::vector<float> ages(static_cast<size_t>(g.cells_xy()));
   size_t occupied_columns = 0;
+  size_t older = 0;
   for (int j = 0; j < g.cells_xy(); ++j) {
     g.row(j, row);
+    g.row_occupied_for(j, 2500ms, ages);
     for (int i = 0; i < g.cells_xy(); ++i) {
       ASSERT_EQ(row[static_cast<size_t>(i)], g.column(i, j)) << i << "," << j;
+      ASSERT_EQ(ages[static_cast<size_t>(i)], static_cast<float>(g.occupied_for_s(i, j, 2500ms)))
+          << i << "," << j;
       occupied_columns += row[static_cast<size_t>(i)] != 0 ? 1U : 0U;
+      older += ages[static_cast<size_t>(i)] > 1.0f ? 1U : 0U;
     }
   }
   EXPECT_GT(occupied_columns, 100U);
+  EXPECT_GT(older, 50U) << "the first scan's columns, 1.5 s old";
+}
+
+// How long a column has held an obstacle (what tells a wall from a passer-by,
+// ObstacleSpeedConfig::settled_s): it grows while scans keep the column occupied, a column
+// cleared by one ray and marked by another in the same scan keeps its age, and it starts again
+// once the column was emptied: by a ray, by decay, by leaving the window (a step, or a jump).
+TEST(VoxelGrid, AColumnsAgeGrowsWhileOccupiedAndStartsAgainOnceEmptied) {
+  core::VoxelGrid g(small_grid());  // 0.1 m cells, decay 2 s
+  g.recentre(0, 0);
+  const auto cell = [&](double v) {
+    return static_cast<int>(std::floor(v / 0.1)) + g.cells_xy() / 2;
+  };
+  const int i = cell(2.05);
+  const int j = cell(0.05);
+  const std::vector<Ray> wall{ray_to(2.05, 0.05, 0.55)};
+  const std::vector<Ray> through{ray_to(3.05, 0.05, 0.55)};  // passes through the wall's voxel
+  g.insert(wall, {}, std::nullopt, 1s);
+  EXPECT_EQ(g.occupied_for_s(i, j, 1s), 0.0);
+  EXPECT_NEAR(g.occupied_for_s(i, j, 1500ms), 0.5, 1e-9);
+  g.insert(wall, {}, std::nullopt, 1500ms);
+  EXPECT_NEAR(g.occupied_for_s(i, j, 1500ms), 0.5, 1e-9) << "seen again: as old as it was";
+  const uint64_t cleared = g.stats().cleared;
+  g.insert(std::vector<Ray>{through[0], wall[0]}, {}, std::nullopt, 2s);
+  ASSERT_GT(g.stats().cleared, cleared) << "the ray through it cleared the voxel";
+  ASSERT_NE(g.column(i, j), 0U) << "and the other marked it again";
+  EXPECT_NEAR(g.occupied_for_s(i, j, 2s), 1.0, 1e-9) << "cleared and marked in one scan";
+  g.insert(through, {}, std::nullopt, 2500ms);
+  ASSERT_EQ(g.column(i, j), 0U);
+  EXPECT_EQ(g.occupied_for_s(i, j, 2500ms), 0.0) << "empty: no age";
+  g.insert(wall, {}, std::nullopt, 3s);
+  EXPECT_NEAR(g.occupied_for_s(i, j, 3200ms), 0.2, 1e-9) << "from the scan that marked it again";
+  g.decay(5100ms);  // not marked for 2.1 s
+  ASSERT_EQ(g.column(i, j), 0U);
+  g.insert(wall, {}, std::nullopt, 5200ms);
+  EXPECT_EQ(g.occupied_for_s(i, j, 5200ms), 0.0) << "after decay freed it";
+  g.insert(wall, {}, std::nullopt, 5500ms);
+  g.recentre(7.0, 0.0);  // the window [3, 11) m: the column leaves it
+  g.recentre(0.0, 0.0);
+  ASSERT_EQ(g.column(i, j), 0U);
+  g.insert(wall, {}, std::nullopt, 6s);
+  EXPECT_EQ(g.occupied_for_s(i, j, 6s), 0.0) << "after it left the window";
+  g.insert(wall, {}, std::nullopt, 6500ms);
+  g.recentre(100.0, 0.0);  // a jump: the whole window emptied at once
+  g.recentre(0.0, 0.0);
+  g.insert(wall, {}, std::nullopt, 7s);
+  EXPECT_EQ(g.occupied_for_s(i, j, 7s), 0.0) << "after a jump of the window";
+  EXPECT_EQ(g.occupied_for_s(i, j, 6s), 0.0) << "a time before the mark reads as just marked";
 }
 
 // A ray that starts on a block's face and runs nearly parallel to it (its move across the face,
@@ -559,6 +618,40 @@ TEST(Costmap, ObstacleCellsAreTheOccupiedColumnsAndTravelWithACopy) {
   core::Costmap copy;
   copy.copy_cells_from(m);
   check(copy, "copied");
+}
+
+// Each obstacle cell carries how long its column has been occupied (the grid's age, in steps of
+// kObstacleAgeStepS, older than kObstacleAgeMaxS read as that), taken when the map is built,
+// and carries it in a snapshot's copy.
+TEST(Costmap, ObstacleCellsCarryTheirColumnsAge) {
+  core::VoxelGrid g = four_metre_grid();
+  std::mt19937 rng(9);
+  scatter_obstacles(g, rng, 25, 1s);
+  scatter_obstacles(g, rng, 25, 1730ms);
+  core::Costmap m;
+  auto check = [&](const core::Costmap& map, Nanos built, double first_age_s) {
+    size_t first = 0;
+    for (int j = 0; j < map.cells(); ++j) {
+      for (int i = 0; i < map.cells(); ++i) {
+        const double grid_age = g.occupied_for_s(i, j, built);
+        const double expected =
+            std::min(std::floor(grid_age / core::Costmap::kObstacleAgeStepS + 1e-6),
+                     core::Costmap::kObstacleAgeMaxS / core::Costmap::kObstacleAgeStepS) *
+            core::Costmap::kObstacleAgeStepS;
+        ASSERT_NEAR(map.obstacle_age_s(i, j), expected, 1e-9) << i << "," << j;
+        first += std::abs(map.obstacle_age_s(i, j) - first_age_s) < 1e-9 ? 1U : 0U;
+      }
+    }
+    EXPECT_GT(first, 10U) << "the first scan's cells";
+  };
+  m.build(g, core::CostmapConfig{}, 2s);
+  check(m, 2s, 1.0);  // the second scan's: 0.27 s, read as 0.25
+  m.build(g, core::CostmapConfig{}, 60s);
+  check(m, 60s, core::Costmap::kObstacleAgeMaxS);
+  core::Costmap copy;
+  copy.copy_cells_from(m);
+  check(copy, 60s, core::Costmap::kObstacleAgeMaxS);
+  EXPECT_EQ(m.obstacle_age_s(-1, 0), 0.0);
 }
 
 // The controller's collision test (cost_at_least: a quad's cell range decides most points

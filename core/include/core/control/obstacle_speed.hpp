@@ -19,8 +19,13 @@
 // this stage keep the command from dropping faster than the base can brake.
 // Why it exists: in the dead-end corridors the barrier's repair and the plan's sidestep round a
 // person walking back at the robot drove it into the corridor's wall (docs/EVALUATION.md,
-// thirty-third session). Obstacles are what the lidar sees, pedestrians included (as if they
-// stood still); the followed person is masked out of the costmap (closing_speed.hpp is theirs).
+// thirty-third session). Obstacles are the costmap's cells that have held an obstacle for at
+// least `settled_s` (Costmap::obstacle_age_s): walls, furniture, a person standing. A walking
+// pedestrian's cells are younger (they leave each within a fraction of a second): taken as
+// standing, the limit slowed the robot in their way until they walked into it (crowds, same
+// section); the plan's collision cost and the supervisor keep them. The followed person is
+// masked out of the costmap (closing_speed.hpp is theirs). What a cost: a wall that comes into
+// view within reach (round a corner) is not limited for its first `settled_s`.
 #include <vector>
 
 #include "core/control/closing_speed.hpp"
@@ -34,6 +39,7 @@ struct ObstacleSpeedConfig {
   double robot_decel_mps2 = 0;    // a_r; 0 = off
   double reaction_time_s = 0.05;  // t_r: command latency and the control period
   double margin_m = 0.05;         // the fastest point's travel left before a stop would touch
+  double settled_s = 1.0;         // an obstacle cell counts once it has been occupied this long
   double sweep_step_m = 0.02;     // the fastest point's travel between the poses checked
   Footprint footprint;
 };

@@ -93,10 +93,16 @@ class Costmap {
   [[nodiscard]] size_t obstacle_cells() const { return obstacles_; }
   // Whether cell (i, j) holds an obstacle itself (a column of occupied voxels; the cost is
   // lethal round it too, out to the inscribed radius). Off the map: false (nothing seen there).
-  [[nodiscard]] bool obstacle(int i, int j) const {
-    if (i < 0 || j < 0 || i >= n_ || j >= n_) return false;
-    return obstacle_[static_cast<size_t>(j) * static_cast<size_t>(n_) + static_cast<size_t>(i)] !=
-           0;
+  [[nodiscard]] bool obstacle(int i, int j) const { return obstacle_code(i, j) != 0; }
+  // How long cell (i, j) has held an obstacle when the map was built (VoxelGrid::occupied_for_s),
+  // in steps of kObstacleAgeStepS up to kObstacleAgeMaxS (older reads as that); 0 where there is
+  // none. A walking pedestrian's cells are a fraction of a second old, a wall's as old as it has
+  // been in view.
+  static constexpr double kObstacleAgeStepS = 0.05;
+  static constexpr double kObstacleAgeMaxS = 254 * kObstacleAgeStepS;
+  [[nodiscard]] double obstacle_age_s(int i, int j) const {
+    const uint8_t code = obstacle_code(i, j);
+    return code == 0 ? 0.0 : (code - 1) * kObstacleAgeStepS;
   }
 
  private:
@@ -121,6 +127,10 @@ class Costmap {
   // floor() without the libm call (the controller looks the costmap up 200 000 times per step);
   // callers keep |v| < 1e9.
   static int floor_int(double v) { return static_cast<int>(floor_to_int(v)); }
+  [[nodiscard]] uint8_t obstacle_code(int i, int j) const {
+    if (i < 0 || j < 0 || i >= n_ || j >= n_) return 0;
+    return obstacle_[static_cast<size_t>(j) * static_cast<size_t>(n_) + static_cast<size_t>(i)];
+  }
 
   // The least and greatest cost of the four cells of the quad whose lower corner is cell (i, j),
   // i, j in -1 .. n - 1 (cells off the map count as lethal, as cell() has them).
@@ -135,13 +145,15 @@ class Costmap {
   Nanos stamp_{0};
   size_t obstacles_ = 0;
   std::vector<uint8_t> cost_;
-  std::vector<uint8_t> obstacle_;  // 1 where the cell is an obstacle (distance 0)
+  // 0: no obstacle; else 1 + the obstacle's age in kObstacleAgeStepS (capped at 254).
+  std::vector<uint8_t> obstacle_;
   // (n + 1) x (n + 1), row j + 1, column i + 1 (an empty map: its one quad, all off the map)
   std::vector<CellRange> quad_range_ =
       std::vector<CellRange>(1, CellRange{kCostLethal, kCostLethal});
   // distance transform work buffers
   std::vector<float> dist2_;
-  std::vector<uint64_t> row_;  // one grid row's column masks
+  std::vector<uint64_t> row_;   // one grid row's column masks
+  std::vector<float> row_age_;  // and how long each has been occupied (s)
   std::vector<float> f_, g_, z_;
   std::vector<int> v_;
   // cost by squared distance in cells, for the configuration it was made for

@@ -8,7 +8,10 @@
 //     except inside the robot's footprint (self-filter) and around the tracked person (mask);
 //   - clearing: every voxel a ray passes through before its end point is free (3-D DDA from the
 //     sensor origin: the same rays that mark, so nothing is marked that cannot be cleared);
-//   - decay: a voxel not re-marked for `decay_s` is freed.
+//   - decay: a voxel not re-marked for `decay_s` is freed;
+//   - age: how long each column has held an obstacle, as the ends of scans saw it (a wall's
+//     columns stay occupied for as long as it is in view; a walking pedestrian leaves a column
+//     within a fraction of a second), so consumers can tell settled obstacles from moving ones.
 // Each column of the window holds a 64-bit occupancy mask (so the height band is at most 64
 // voxels) and a per-voxel marking time. Memory is fixed at construction; nothing allocates after.
 // The window side is rounded up to a multiple of 16 cells (rays skip empty 16 x 16 blocks).
@@ -110,6 +113,13 @@ class VoxelGrid {
   // The masks of window row j (0 <= j < cells_xy()), columns i = 0 .. cells_xy() - 1, into out
   // (cells_xy() entries): two contiguous runs of the storage, no wrapping per column.
   void row(int j, std::span<uint64_t> out) const;
+  // How long the column at window cell (i, j) has been occupied at `now` (seconds; 0 if empty):
+  // since the end of the first scan (insert) that left it occupied after one that left it
+  // empty (or emptied it by decay, or a move of the window). A column cleared and marked again
+  // within one scan stays as old as it was. Resolution 10 ms.
+  [[nodiscard]] double occupied_for_s(int i, int j, Nanos now) const;
+  // The same for window row j (cells_xy() entries): what the costmap reads once per build.
+  void row_occupied_for(int j, Nanos now, std::span<float> seconds) const;
   [[nodiscard]] bool occupied(double x, double y, double z) const;
   [[nodiscard]] size_t occupied_count() const;
   // Bytes held by the grid's buffers (fixed at construction).
@@ -150,6 +160,12 @@ class VoxelGrid {
   bool placed_ = false;
   std::vector<uint64_t> mask_;   // per column
   std::vector<uint16_t> stamp_;  // per voxel: marking time, 10 ms units (wraps at 655 s)
+  // Per column: when it became occupied, 10 ms units (wraps after 497 days); kNotOccupied while
+  // empty. Updated at the end of each insert, so clearing and marking within one scan do not
+  // make a standing wall's columns new.
+  static constexpr uint32_t kNotOccupied = 0xFFFFFFFFU;
+  std::vector<uint32_t> occupied_since_;
+  void update_occupied_since(Nanos now);
   // Non-empty columns per block of kBlock x kBlock columns: rays skip empty blocks whole.
   static constexpr int kBlock = 16;  // the ray loop divides by shifting kBlockShift bits
   static constexpr int kBlockShift = 4;

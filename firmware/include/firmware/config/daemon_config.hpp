@@ -178,6 +178,7 @@ struct DaemonConfig {
     double robot_decel_mps2 = 0;  // 0: off
     double reaction_time_s = 0;
     double margin_m = 0;
+    double settled_s = 0;
   } obstacle_speed;
 };
 
