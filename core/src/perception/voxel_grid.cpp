@@ -684,16 +684,19 @@ double VoxelGrid::occupied_for_s(int i, int j, Nanos now) const {
 
 void VoxelGrid::row_occupied_for(int j, Nanos now, std::span<float> seconds) const {
   const auto n = static_cast<size_t>(n_);
-  const size_t first = slot(ox_, oy_ + j);
+  const size_t first = slot(ox_, oy_ + j);  // window column 0 of the row
   const size_t row_start = first - first % n;
+  const size_t wrapped = n - first % n;  // columns before the storage row wraps
   const uint32_t t = since_units(now);
-  for (size_t i = 0; i < n; ++i) {
-    const size_t col = (first % n) + i < n ? first + i : row_start + (first % n + i - n);
-    const uint32_t since = occupied_since_[col];
-    seconds[i] = since == kNotOccupied
-                     ? 0.0f
-                     : static_cast<float>(std::max(0, static_cast<int32_t>(t - since))) * 0.01f;
-  }
+  const auto age_s = [t](uint32_t since) {
+    return since == kNotOccupied
+               ? 0.0f
+               : static_cast<float>(std::max(0, static_cast<int32_t>(t - since))) * 0.01f;
+  };
+  for (size_t i = 0; i < wrapped; ++i)
+    seconds[i] = age_s(occupied_since_[first + i]);
+  for (size_t i = wrapped; i < n; ++i)
+    seconds[i] = age_s(occupied_since_[row_start + i - wrapped]);
 }
 
 bool VoxelGrid::occupied(double x, double y, double z) const {
