@@ -225,7 +225,8 @@ core::Costmap wall_scene(bool closed) {
   }
   g.insert(rays, core::Pose2{30, 30, 0}, std::nullopt, 1s);
   core::Costmap m;
-  m.build(g, core::CostmapConfig{}, 1s);
+  // Ten seconds after the scan: walls the obstacle limit counts (obstacle_speed.settled_s).
+  m.build(g, core::CostmapConfig{}, 11s);
   return m;
 }
 

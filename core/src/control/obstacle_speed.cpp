@@ -22,7 +22,7 @@ void gather(const Costmap& map, const Pose2& robot, double radius_m, double sett
   const Pose2 odom_in_base = robot.inverse();
   for (int j = j0; j <= j1; ++j) {
     for (int i = i0; i <= i1; ++i) {
-      if (!map.obstacle(i, j) || map.obstacle_age_s(i, j) < settled_s) continue;
+      if (!map.obstacle_at_least(i, j, settled_s)) continue;
       const double x = map.origin_x() + (i + 0.5) * res;
       const double y = map.origin_y() + (j + 0.5) * res;
       if (std::hypot(x - robot.x_m, y - robot.y_m) > radius_m) continue;

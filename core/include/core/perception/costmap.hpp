@@ -104,6 +104,11 @@ class Costmap {
     const uint8_t code = obstacle_code(i, j);
     return code == 0 ? 0.0 : (code - 1) * kObstacleAgeStepS;
   }
+  // An obstacle at least `min_age_s` old in cell (i, j) (one read: the obstacle limit's scan).
+  [[nodiscard]] bool obstacle_at_least(int i, int j, double min_age_s) const {
+    const uint8_t code = obstacle_code(i, j);
+    return code != 0 && (code - 1) * kObstacleAgeStepS >= min_age_s;
+  }
 
  private:
   // Bounds the rounding of a bilinear value (a few ulp of 100) in the range tests.
