@@ -75,7 +75,7 @@ void Costmap::build(const VoxelGrid& grid, const CostmapConfig& config, Nanos st
   const auto n = static_cast<size_t>(n_);
   for (int j = 0; j < n_; ++j) {
     grid.row(j, row_);
-    grid.row_occupied_for(j, stamp, row_age_);
+    grid.row_occupied_ticks(j, stamp, row_age_);
     float* out = &dist2_[static_cast<size_t>(j) * n];
     uint8_t* obstacle_out = &obstacle_[static_cast<size_t>(j) * n];
     size_t row_obstacles = 0;
@@ -83,10 +83,9 @@ void Costmap::build(const VoxelGrid& grid, const CostmapConfig& config, Nanos st
       const bool obstacle = row_[i] != 0;
       row_obstacles += obstacle ? 1U : 0U;
       f_[i] = obstacle ? 0.0f : kInf;
-      // Ages are whole 10 ms: the small addition keeps 1.0 s from rounding to 0.95.
-      const float steps =
-          std::min(row_age_[i] / static_cast<float>(kObstacleAgeStepS) + 1e-3f, 254.0f);
-      obstacle_out[i] = obstacle ? static_cast<uint8_t>(1 + static_cast<int>(steps)) : 0;
+      obstacle_out[i] =
+          obstacle ? static_cast<uint8_t>(1 + std::min(row_age_[i] / kObstacleAgeStepTicks, 254U))
+                   : 0;
     }
     obstacles_ += row_obstacles;
     if (row_obstacles == 0) {

@@ -665,38 +665,32 @@ uint64_t VoxelGrid::column(int i, int j) const {
   return mask_[slot(ox_ + i, oy_ + j)];
 }
 
-void VoxelGrid::row(int j, std::span<uint64_t> out) const {
+VoxelGrid::RowRuns VoxelGrid::row_runs(int j) const {
   const auto n = static_cast<size_t>(n_);
   const size_t first = slot(ox_, oy_ + j);  // window column 0 of the row
-  const size_t row_start = first - first % n;
-  const size_t wrapped = n - first % n;  // columns before the storage row wraps
-  std::copy_n(mask_.begin() + static_cast<std::ptrdiff_t>(first), wrapped, out.begin());
-  std::copy_n(mask_.begin() + static_cast<std::ptrdiff_t>(row_start), n - wrapped,
-              out.begin() + static_cast<std::ptrdiff_t>(wrapped));
+  return RowRuns{first, first - first % n, n - first % n};
+}
+
+void VoxelGrid::row(int j, std::span<uint64_t> out) const {
+  const RowRuns r = row_runs(j);
+  const auto n = static_cast<size_t>(n_);
+  std::copy_n(mask_.begin() + static_cast<std::ptrdiff_t>(r.first), r.wrapped, out.begin());
+  std::copy_n(mask_.begin() + static_cast<std::ptrdiff_t>(r.row_start), n - r.wrapped,
+              out.begin() + static_cast<std::ptrdiff_t>(r.wrapped));
 }
 
 double VoxelGrid::occupied_for_s(int i, int j, Nanos now) const {
-  const uint32_t since = occupied_since_[slot(ox_ + i, oy_ + j)];
-  if (since == kNotOccupied) return 0.0;
-  // A `now` before the mark (a replay restarted) reads as just marked, not as 497 days.
-  return std::max(0, static_cast<int32_t>(since_units(now) - since)) * 0.01;
+  return age_ticks(occupied_since_[slot(ox_ + i, oy_ + j)], since_units(now)) * kAgeTickS;
 }
 
-void VoxelGrid::row_occupied_for(int j, Nanos now, std::span<float> seconds) const {
+void VoxelGrid::row_occupied_ticks(int j, Nanos now, std::span<uint32_t> ticks) const {
+  const RowRuns r = row_runs(j);
   const auto n = static_cast<size_t>(n_);
-  const size_t first = slot(ox_, oy_ + j);  // window column 0 of the row
-  const size_t row_start = first - first % n;
-  const size_t wrapped = n - first % n;  // columns before the storage row wraps
   const uint32_t t = since_units(now);
-  const auto age_s = [t](uint32_t since) {
-    return since == kNotOccupied
-               ? 0.0f
-               : static_cast<float>(std::max(0, static_cast<int32_t>(t - since))) * 0.01f;
-  };
-  for (size_t i = 0; i < wrapped; ++i)
-    seconds[i] = age_s(occupied_since_[first + i]);
-  for (size_t i = wrapped; i < n; ++i)
-    seconds[i] = age_s(occupied_since_[row_start + i - wrapped]);
+  for (size_t i = 0; i < r.wrapped; ++i)
+    ticks[i] = age_ticks(occupied_since_[r.first + i], t);
+  for (size_t i = r.wrapped; i < n; ++i)
+    ticks[i] = age_ticks(occupied_since_[r.row_start + i - r.wrapped], t);
 }
 
 bool VoxelGrid::occupied(double x, double y, double z) const {

@@ -200,18 +200,19 @@ TEST(VoxelGrid, RowsAreTheWindowsColumnsWhereverTheStorageWraps) {
     r = ray_to(1.35 + u(rng), -2.05 + u(rng), 0.5, Point3{1.35, -2.05, 3.0});
   g.insert(rays, {}, std::nullopt, 2s);
   std::vector<uint64_t> row(static_cast<size_t>(g.cells_xy()));
-  std::vector<float> ages(static_cast<size_t>(g.cells_xy()));
+  std::vector<uint32_t> ages(static_cast<size_t>(g.cells_xy()));
   size_t occupied_columns = 0;
   size_t older = 0;
   for (int j = 0; j < g.cells_xy(); ++j) {
     g.row(j, row);
-    g.row_occupied_for(j, 2500ms, ages);
+    g.row_occupied_ticks(j, 2500ms, ages);
     for (int i = 0; i < g.cells_xy(); ++i) {
       ASSERT_EQ(row[static_cast<size_t>(i)], g.column(i, j)) << i << "," << j;
-      ASSERT_EQ(ages[static_cast<size_t>(i)], static_cast<float>(g.occupied_for_s(i, j, 2500ms)))
+      ASSERT_NEAR(ages[static_cast<size_t>(i)] * core::VoxelGrid::kAgeTickS,
+                  g.occupied_for_s(i, j, 2500ms), 1e-12)
           << i << "," << j;
       occupied_columns += row[static_cast<size_t>(i)] != 0 ? 1U : 0U;
-      older += ages[static_cast<size_t>(i)] > 1.0f ? 1U : 0U;
+      older += ages[static_cast<size_t>(i)] > 100U ? 1U : 0U;  // over 1 s
     }
   }
   EXPECT_GT(occupied_columns, 100U);

@@ -98,7 +98,8 @@ class Costmap {
   // in steps of kObstacleAgeStepS up to kObstacleAgeMaxS (older reads as that); 0 where there is
   // none. A walking pedestrian's cells are a fraction of a second old, a wall's as old as it has
   // been in view.
-  static constexpr double kObstacleAgeStepS = 0.05;
+  static constexpr uint32_t kObstacleAgeStepTicks = 5;  // of VoxelGrid::kAgeTickS
+  static constexpr double kObstacleAgeStepS = kObstacleAgeStepTicks * VoxelGrid::kAgeTickS;
   static constexpr double kObstacleAgeMaxS = 254 * kObstacleAgeStepS;
   [[nodiscard]] double obstacle_age_s(int i, int j) const {
     const uint8_t code = obstacle_code(i, j);
@@ -157,8 +158,8 @@ class Costmap {
       std::vector<CellRange>(1, CellRange{kCostLethal, kCostLethal});
   // distance transform work buffers
   std::vector<float> dist2_;
-  std::vector<uint64_t> row_;   // one grid row's column masks
-  std::vector<float> row_age_;  // and how long each has been occupied (s)
+  std::vector<uint64_t> row_;      // one grid row's column masks
+  std::vector<uint32_t> row_age_;  // and how long each has been occupied (ticks)
   std::vector<float> f_, g_, z_;
   std::vector<int> v_;
   // cost by squared distance in cells, for the configuration it was made for

@@ -15,6 +15,7 @@
 // Each column of the window holds a 64-bit occupancy mask (so the height band is at most 64
 // voxels) and a per-voxel marking time. Memory is fixed at construction; nothing allocates after.
 // The window side is rounded up to a multiple of 16 cells (rays skip empty 16 x 16 blocks).
+#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -116,10 +117,11 @@ class VoxelGrid {
   // How long the column at window cell (i, j) has been occupied at `now` (seconds; 0 if empty):
   // since the end of the first scan (insert) that left it occupied after one that left it
   // empty (or emptied it by decay, or a move of the window). A column cleared and marked again
-  // within one scan stays as old as it was. Resolution 10 ms.
+  // within one scan stays as old as it was. Kept in ticks of kAgeTickS.
+  static constexpr double kAgeTickS = 0.01;
   [[nodiscard]] double occupied_for_s(int i, int j, Nanos now) const;
-  // The same for window row j (cells_xy() entries): what the costmap reads once per build.
-  void row_occupied_for(int j, Nanos now, std::span<float> seconds) const;
+  // The same for window row j in ticks (cells_xy() entries): what the costmap reads per build.
+  void row_occupied_ticks(int j, Nanos now, std::span<uint32_t> ticks) const;
   [[nodiscard]] bool occupied(double x, double y, double z) const;
   [[nodiscard]] size_t occupied_count() const;
   // Bytes held by the grid's buffers (fixed at construction).
@@ -166,6 +168,18 @@ class VoxelGrid {
   static constexpr uint32_t kNotOccupied = 0xFFFFFFFFU;
   std::vector<uint32_t> occupied_since_;
   void update_occupied_since(Nanos now);
+  // Ticks from `since` to `now_ticks`; 0 while empty, and for a `now` before the mark (a replay
+  // restarted reads as just marked, not as 497 days).
+  static uint32_t age_ticks(uint32_t since, uint32_t now_ticks) {
+    if (since == kNotOccupied) return 0;
+    return static_cast<uint32_t>(std::max(0, static_cast<int32_t>(now_ticks - since)));
+  }
+  // Window row j in the per-column storage: `wrapped` columns from `first`, then the rest of
+  // the row from `row_start` (two contiguous runs).
+  struct RowRuns {
+    size_t first, row_start, wrapped;
+  };
+  [[nodiscard]] RowRuns row_runs(int j) const;
   // Non-empty columns per block of kBlock x kBlock columns: rays skip empty blocks whole.
   static constexpr int kBlock = 16;  // the ray loop divides by shifting kBlockShift bits
   static constexpr int kBlockShift = 4;
