@@ -27,7 +27,8 @@ struct ScoutConfig {
 struct IdStats {
   uint64_t count = 0;
   hal::Nanos last{0};
-  double rate_hz = 0;  // exponentially smoothed from the intervals
+  double mean_interval_s = 0;  // exponentially smoothed interval between frames
+  double rate_hz = 0;          // 1 / mean_interval_s (0 until two frames)
 };
 
 struct MotorState {
