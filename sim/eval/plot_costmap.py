@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
 """Draws a costmap snapshot of companion-eval --costmap-at (a map_server map: PGM + YAML) with
 what the daemon knew then: the robot (red), the person (blue) and q^d (green), headings as
-arrows, the cost threshold R as an orange contour, the controller's best plan's cost by term in
-the title. Needs Debian's python3-matplotlib and python3-yaml (run with /usr/bin/python3).
+arrows, the cost threshold R as an orange contour, the obstacle cells old enough for the speed
+limit toward obstacles to count (obstacle_ages, settled_s) in purple, the controller's best
+plan's cost by term in the title. Needs Debian's python3-matplotlib and python3-yaml (run with
+/usr/bin/python3).
 
     /usr/bin/python3 sim/eval/plot_costmap.py OUT/costmaps/random-objective-8-t9.5.yaml [PNG]
 """
@@ -54,6 +56,14 @@ def main():
     xs = ox + (np.arange(w) + 0.5) * res
     ys = oy + (np.arange(h)[::-1] + 0.5) * res
     ax.contour(xs, ys, cost, levels=[float(meta.get("cost_threshold", 30))], colors="orange")
+    ages = meta.get("obstacle_ages")
+    if ages:  # the cells the speed limit toward obstacles counts: obstacles at least settled_s old
+        age_px = read_pgm(os.path.join(os.path.dirname(meta_path), ages["image"])).astype(float)
+        age_s = np.where(age_px < 255, (254.0 - age_px) * float(ages["step_s"]), -1.0)
+        rows, cols = np.nonzero(age_s >= float(ages["settled_s"]))
+        if rows.size:
+            ax.plot(ox + (cols + 0.5) * res, oy + (h - rows - 0.5) * res, "s", color="purple",
+                    ms=2, label=f"obstacle cells >= {float(ages['settled_s']):g} s old")
     arrow(ax, meta["robot"], "red", "robot")
     if meta.get("person"):
         arrow(ax, meta["person"], "blue", "person")

@@ -90,10 +90,12 @@ TEST(CompanionEval, RunsCasesAndMethodsByNameAndWritesTablesCsvAndPlots) {
     ASSERT_GT(png.size(), 1000U) << f;
     EXPECT_EQ(png.substr(1, 3), "PNG") << f;
   }
-  // A costmap snapshot per trial (map_server PGM + YAML), drawn by plot_costmap.py.
+  // A costmap snapshot per trial (map_server PGM + YAML, and the obstacle ages), drawn by
+  // plot_costmap.py.
   const std::string snap = out + "/costmaps/corridor-objective-1-t6.0";
   EXPECT_NE(slurp(snap + ".yaml").find("image: corridor-objective-1-t6.0.pgm"), std::string::npos);
   EXPECT_EQ(slurp(snap + ".pgm").substr(0, 2), "P5");
+  EXPECT_EQ(slurp(snap + "-age.pgm").substr(0, 2), "P5") << "the obstacle ages beside it";
   ChildProcess draw({"/usr/bin/python3", COMPANION_PLOT_COSTMAP_SCRIPT, snap + ".yaml"});
   ASSERT_TRUE(draw.started());
   ASSERT_EQ(draw.wait(120s), 0) << draw.output();

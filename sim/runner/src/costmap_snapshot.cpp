@@ -19,6 +19,22 @@ std::string costmap_pgm(const core::Costmap& map) {
   return out;
 }
 
+std::string costmap_age_pgm(const core::Costmap& map) {
+  const int n = map.cells();
+  std::string out = fmt::format("P5\n{} {}\n255\n", n, n);
+  out.reserve(out.size() + static_cast<size_t>(n) * static_cast<size_t>(n));
+  for (int j = n - 1; j >= 0; --j) {
+    for (int i = 0; i < n; ++i) {
+      long steps = -1;  // no obstacle: 255, white
+      if (map.obstacle(i, j)) {
+        steps = std::lround(map.obstacle_age_s(i, j) / core::Costmap::kObstacleAgeStepS);
+      }
+      out.push_back(static_cast<char>(254 - std::min<long>(steps, 254)));
+    }
+  }
+  return out;
+}
+
 namespace {
 std::string pose(const core::Pose2& p) {
   return fmt::format("[{:.4f}, {:.4f}, {:.4f}]", p.x_m, p.y_m, p.theta_rad);
@@ -43,6 +59,10 @@ std::string costmap_yaml(const core::Costmap& map, const std::string& image_name
       out += (i == 0 ? "" : ", ") + pose(poses[i]);
     out += "]\n";
   };
+  if (!m.age_image.empty()) {
+    out += fmt::format("obstacle_ages: {{image: {}, step_s: {}, settled_s: {}}}\n", m.age_image,
+                       core::Costmap::kObstacleAgeStepS, m.obstacle_settled_s);
+  }
   path("predicted_person", m.predicted_person);
   path("predicted_goal", m.predicted_goal);
   if (m.tracking) {

@@ -104,7 +104,10 @@ void write_costmap_snapshot(const firmware::Daemon& daemon, const firmware::Daem
   }
   const std::string base = fmt::format("{}-t{:.1f}", stem, t_s);
   const std::string image = std::filesystem::path(base + ".pgm").filename().string();
+  m.age_image = std::filesystem::path(base + "-age.pgm").filename().string();
+  m.obstacle_settled_s = cfg.obstacle_speed.settled_s;
   std::ofstream(base + ".pgm", std::ios::binary) << costmap_pgm(*map);
+  std::ofstream(base + "-age.pgm", std::ios::binary) << costmap_age_pgm(*map);
   std::ofstream(base + ".yaml") << costmap_yaml(*map, image, m);
 }
 }  // namespace

@@ -725,41 +725,66 @@ TEST(RunReport, WorldCsvListsEveryWallAndObstacleForThePlots) {
 // ---- costmap snapshots (companion-eval --costmap-at) ------------------------------------------
 
 namespace {
-core::Costmap wall_costmap() {  // a wall across x = 1.5 m, |y| <= 0.6 m, in a 10 m map
+// A wall across x = 1.5 m, |y| <= 0.6 m, in a 10 m map, scanned at each of `scans` (ascending);
+// the map is built at the last.
+core::Costmap wall_costmap(std::initializer_list<core::Nanos> scans = {1s}) {
   core::VoxelGridConfig gc;
   gc.size_xy_m = 10.0;
   core::VoxelGrid g(gc);
   g.recentre(1.5, 0);
   std::vector<core::Ray> rays;
-  for (double y = -0.6; y <= 0.6; y += 0.02)
-    rays.push_back({{1.5, -3.0, 3.0}, {1.5, y, 0.5}});
-  g.insert(rays, Pose2{30, 30, 0}, std::nullopt, 1s);
+  for (int k = 0; k <= 60; ++k) {  // every 2 cm
+    rays.push_back({{1.5, -3.0, 3.0}, {1.5, -0.6 + 0.02 * k, 0.5}});
+  }
+  for (const core::Nanos t : scans)
+    g.insert(rays, Pose2{30, 30, 0}, std::nullopt, t);
   core::Costmap m;
-  m.build(g, core::CostmapConfig{}, 1s);
+  m.build(g, core::CostmapConfig{}, *(scans.end() - 1));
   return m;
+}
+
+// The pixel of a snapshot image (costmap_pgm's layout) over the point (x, y); checks the header.
+uint8_t pgm_pixel(const std::string& pgm, const core::Costmap& map, double x, double y) {
+  const int n = map.cells();
+  const std::string header = "P5\n" + std::to_string(n) + " " + std::to_string(n) + "\n255\n";
+  EXPECT_EQ(pgm.compare(0, header.size(), header), 0);
+  EXPECT_EQ(pgm.size(), header.size() + static_cast<size_t>(n) * static_cast<size_t>(n));
+  const int i = static_cast<int>(std::floor((x - map.origin_x()) / map.resolution()));
+  const int j = static_cast<int>(std::floor((y - map.origin_y()) / map.resolution()));
+  const size_t row = static_cast<size_t>(n - 1 - j);  // the top row is the largest y
+  return static_cast<uint8_t>(
+      pgm.at(header.size() + row * static_cast<size_t>(n) + static_cast<size_t>(i)));
 }
 }  // namespace
 
 TEST(CostmapSnapshot, IsAMapServerPgmWithTheTopRowTheLargestY) {
   const core::Costmap map = wall_costmap();
-  const int n = map.cells();
   const std::string pgm = sim::costmap_pgm(map);
-  const std::string header = "P5\n" + std::to_string(n) + " " + std::to_string(n) + "\n255\n";
-  ASSERT_EQ(pgm.compare(0, header.size(), header), 0);
-  ASSERT_EQ(pgm.size(), header.size() + static_cast<size_t>(n) * static_cast<size_t>(n));
-  auto pixel = [&](double x, double y) {
-    const int i = static_cast<int>(std::floor((x - map.origin_x()) / map.resolution()));
-    const int j = static_cast<int>(std::floor((y - map.origin_y()) / map.resolution()));
-    const size_t row = static_cast<size_t>(n - 1 - j);  // the top row is the largest y
-    return static_cast<uint8_t>(
-        pgm[header.size() + row * static_cast<size_t>(n) + static_cast<size_t>(i)]);
-  };
+  auto pixel = [&](double x, double y) { return pgm_pixel(pgm, map, x, y); };
   ASSERT_EQ(map.at(1.5, 0.0), core::kCostLethal);
   EXPECT_EQ(pixel(1.5, 0.0), 0) << "lethal is black";
   EXPECT_EQ(pixel(1.5, 3.0), 255) << "free is white";
   EXPECT_EQ(pixel(-2.0, 0.0), 255);
   // Inflation: grey between, darker nearer the wall.
   EXPECT_LT(pixel(1.5, 0.95), pixel(1.5, 1.2));
+}
+
+// The obstacle layer's ages: a wall seen at 1 s and again at 2.5 s is 1.5 s old in the map built
+// then; no obstacle (free, or only inflated round one) is white.
+TEST(CostmapSnapshot, AgeImageShowsHowLongEachObstacleCellHasStood) {
+  const core::Costmap map = wall_costmap({1s, 2500ms});
+  const std::string pgm = sim::costmap_age_pgm(map);
+  ASSERT_EQ(map.at(1.5, 0.0), core::kCostLethal);
+  const auto i = static_cast<int>(std::floor((1.5 - map.origin_x()) / map.resolution()));
+  const auto j = static_cast<int>(std::floor((0.0 - map.origin_y()) / map.resolution()));
+  ASSERT_TRUE(map.obstacle(i, j));
+  EXPECT_NEAR(map.obstacle_age_s(i, j), 1.5, 1e-9);
+  EXPECT_EQ(pgm_pixel(pgm, map, 1.5, 0.0), 254 - 30) << "1.5 s in 0.05 s steps";
+  EXPECT_EQ(pgm_pixel(pgm, map, 1.5, 3.0), 255) << "free";
+  EXPECT_EQ(pgm_pixel(pgm, map, 1.2, 0.0), 255) << "inflated round the wall, no obstacle";
+  // A wall seen once, in the map built at that scan: a new obstacle, just off white.
+  const core::Costmap fresh = wall_costmap();
+  EXPECT_EQ(pgm_pixel(sim::costmap_age_pgm(fresh), fresh, 1.5, 0.0), 254);
 }
 
 TEST(CostmapSnapshot, YamlHasTheMapServerKeysAndWhatTheDaemonKnew) {
@@ -786,6 +811,12 @@ TEST(CostmapSnapshot, YamlHasTheMapServerKeysAndWhatTheDaemonKnew) {
       "goal: [1.0000, 0.7000, 0.0000]\n",
       "predicted_goal: [[1.0000, 0.7000, 0.0000], [1.8000, 0.7000, 0.0000]]\n",
       "plan_cost: {tracking: 5199.9, collision: 0.0, barrier: 0.0}\n"};
+  EXPECT_EQ(y.find("obstacle_ages"), std::string::npos) << "no age image named: no key";
+  m.age_image = "snap-age.pgm";
+  m.obstacle_settled_s = 1.0;
+  EXPECT_NE(sim::costmap_yaml(map, "snap.pgm", m)
+                .find("obstacle_ages: {image: snap-age.pgm, step_s: 0.05, settled_s: 1}\n"),
+            std::string::npos);
   for (const std::string& want : wanted) {
     EXPECT_NE(y.find(want), std::string::npos) << want << " in\n" << y;
   }
@@ -813,10 +844,14 @@ TEST(CostmapSnapshot, ARunWritesOneAtEachTimeAsked) {
     std::stringstream text;
     text << yaml.rdbuf();
     EXPECT_NE(text.str().find("image: trial-t" + std::string(t) + ".pgm"), std::string::npos);
-    std::ifstream pgm(stem.string() + ".pgm", std::ios::binary);
-    ASSERT_TRUE(pgm.good()) << stem;
-    std::string head(2, '\0');
-    pgm.read(head.data(), 2);
-    EXPECT_EQ(head, "P5");
+    EXPECT_NE(text.str().find("obstacle_ages: {image: trial-t" + std::string(t) + "-age.pgm"),
+              std::string::npos);
+    for (const char* suffix : {".pgm", "-age.pgm"}) {
+      std::ifstream pgm(stem.string() + suffix, std::ios::binary);
+      ASSERT_TRUE(pgm.good()) << stem << suffix;
+      std::string head(2, '\0');
+      pgm.read(head.data(), 2);
+      EXPECT_EQ(head, "P5");
+    }
   }
 }
