@@ -6,33 +6,35 @@
 
 namespace sim {
 
-std::string costmap_pgm(const core::Costmap& map) {
+namespace {
+// A binary PGM of the map's cells, one pixel a cell, the top row the largest y; `pixel(i, j)`
+// gives the cell's grey value.
+template <typename Pixel>
+std::string map_pgm(const core::Costmap& map, Pixel pixel) {
   const int n = map.cells();
   std::string out = fmt::format("P5\n{} {}\n255\n", n, n);
   out.reserve(out.size() + static_cast<size_t>(n) * static_cast<size_t>(n));
   for (int j = n - 1; j >= 0; --j) {
-    for (int i = 0; i < n; ++i) {
-      const int cost = std::min<int>(map.cell(i, j), 100);
-      out.push_back(static_cast<char>(255 - static_cast<int>(std::lround(cost * 2.55))));
-    }
+    for (int i = 0; i < n; ++i)
+      out.push_back(static_cast<char>(pixel(i, j)));
   }
   return out;
 }
+}  // namespace
+
+std::string costmap_pgm(const core::Costmap& map) {
+  return map_pgm(map, [&](int i, int j) {
+    const int cost = std::min<int>(map.cell(i, j), 100);
+    return 255 - static_cast<int>(std::lround(cost * 2.55));
+  });
+}
 
 std::string costmap_age_pgm(const core::Costmap& map) {
-  const int n = map.cells();
-  std::string out = fmt::format("P5\n{} {}\n255\n", n, n);
-  out.reserve(out.size() + static_cast<size_t>(n) * static_cast<size_t>(n));
-  for (int j = n - 1; j >= 0; --j) {
-    for (int i = 0; i < n; ++i) {
-      long steps = -1;  // no obstacle: 255, white
-      if (map.obstacle(i, j)) {
-        steps = std::lround(map.obstacle_age_s(i, j) / core::Costmap::kObstacleAgeStepS);
-      }
-      out.push_back(static_cast<char>(254 - std::min<long>(steps, 254)));
-    }
-  }
-  return out;
+  return map_pgm(map, [&](int i, int j) {
+    if (!map.obstacle(i, j)) return 255L;  // white
+    const long steps = std::lround(map.obstacle_age_s(i, j) / core::Costmap::kObstacleAgeStepS);
+    return 254 - std::min<long>(steps, 254);
+  });
 }
 
 namespace {
