@@ -134,7 +134,7 @@ std::string json_state(const sm::ScoutMini& d, Nanos now) {
     const auto& st = d.id_stats(id);
     ids += fmt::format(
         "{}\"0x{:03X}\":{{\"count\":{},\"rate_hz\":{:.1f},\"age_ms\":{}}}", ids.empty() ? "" : ",",
-        id, st.count, st.rate_hz,
+        id, st.count, st.rate_hz(),
         st.count ? fmt::format("{:.1f}", static_cast<double>((now - st.last).count()) * 1e-6)
                  : std::string("null"));
   }
@@ -185,7 +185,7 @@ std::string text_state(const sm::ScoutMini& d, Nanos now) {
   for (const auto& [id, min_hz] : expected_ids()) {
     const auto& st = d.id_stats(id);
     out += fmt::format(
-        "  0x{:03X} {:6} frames {:6.1f} Hz  age {}\n", id, st.count, st.rate_hz,
+        "  0x{:03X} {:6} frames {:6.1f} Hz  age {}\n", id, st.count, st.rate_hz(),
         st.count ? fmt::format("{:.0f} ms", static_cast<double>((now - st.last).count()) * 1e-6)
                  : std::string("never"));
   }
@@ -367,9 +367,9 @@ int run(int argc, char** argv) {
     for (const auto& [id, min_hz] : expected_ids()) {
       const auto& st = driver.id_stats(id);
       const bool fresh = st.count > 0 && now - st.last < 500ms;
-      line(fresh && st.rate_hz >= min_hz,
+      line(fresh && st.rate_hz() >= min_hz,
            fmt::format("id 0x{:03X}: {} frames, {:.1f} Hz (>= {:.0f} Hz expected){}", id, st.count,
-                       st.rate_hz, min_hz, fresh || st.count == 0 ? "" : ", stale"));
+                       st.rate_hz(), min_hz, fresh || st.count == 0 ? "" : ", stale"));
     }
     line(s.system_state_seen && s.vehicle_state == sm::VehicleState::kNormal,
          "vehicle state: " + vehicle_name(s.vehicle_state));

@@ -90,9 +90,9 @@ void enables_drives_and_stops(Rig& rig) {
   EXPECT_NEAR(rig.driver.state().odom.x_m, rig.base.pose().x_m, 0.03);
   EXPECT_NEAR(rig.driver.state().odom.y_m, rig.base.pose().y_m, 0.03);
   EXPECT_NEAR(rig.driver.state().odom.theta_rad, rig.base.pose().theta_rad, 0.02);
-  EXPECT_GT(rig.driver.id_stats(0x221).rate_hz, 45.0);
-  EXPECT_LT(rig.driver.id_stats(0x221).rate_hz, 55.0);
-  EXPECT_GT(rig.driver.id_stats(0x211).rate_hz, 9.0);
+  EXPECT_GT(rig.driver.id_stats(0x221).rate_hz(), 45.0);
+  EXPECT_LT(rig.driver.id_stats(0x221).rate_hz(), 55.0);
+  EXPECT_GT(rig.driver.id_stats(0x211).rate_hz(), 9.0);
 
   // Told to stop: the very next command period carries zero and the base decelerates at once.
   const double before = rig.base.velocity().vx_mps;

@@ -25,11 +25,9 @@ hal::CanSendResult ScoutMini::send(const hal::CanFrame& f) {
 void ScoutMini::count_id(uint32_t can_id, hal::Nanos stamp) {
   IdStats& s = ids_[can_id & 0x7FF];
   if (s.count > 0 && stamp > s.last) {
-    // Smooth the interval, not its reciprocal: the mean of 1/dt is biased high under jitter
-    // (5 ms and 35 ms alternating read over 100 Hz for a 50 Hz stream); 1 / mean(dt) does not.
+    // Smooth the interval, not its reciprocal (IdStats::rate_hz says why).
     const double interval_s = 1e-9 * static_cast<double>((stamp - s.last).count());
     s.mean_interval_s = s.count == 1 ? interval_s : 0.8 * s.mean_interval_s + 0.2 * interval_s;
-    s.rate_hz = 1.0 / s.mean_interval_s;
   }
   ++s.count;
   s.last = stamp;

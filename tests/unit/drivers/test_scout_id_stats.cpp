@@ -33,7 +33,7 @@ TEST(ScoutIdStats, RateOfARegularStreamIsItsFrequency) {
     rig.send_motion_after(20ms);
   const scout_mini::IdStats& s = rig.driver.id_stats(0x221);
   EXPECT_EQ(s.count, 100U);
-  EXPECT_NEAR(s.rate_hz, 50.0, 1e-6);
+  EXPECT_NEAR(s.rate_hz(), 50.0, 1e-6);
 }
 
 // 50 frames a second on average, arriving 5 ms and 35 ms apart in turn (a jittery adapter or a
@@ -45,15 +45,15 @@ TEST(ScoutIdStats, JitterDoesNotInflateTheRate) {
     rig.send_motion_after(i % 2 == 0 ? 5ms : 35ms);
   const scout_mini::IdStats& s = rig.driver.id_stats(0x221);
   EXPECT_EQ(s.count, 200U);
-  EXPECT_NEAR(s.rate_hz, 50.0, 4.0);
+  EXPECT_NEAR(s.rate_hz(), 50.0, 4.0);
 }
 
 TEST(ScoutIdStats, NoRateBeforeTheSecondFrame) {
   Rig rig;
-  EXPECT_EQ(rig.driver.id_stats(0x221).rate_hz, 0.0);
+  EXPECT_EQ(rig.driver.id_stats(0x221).rate_hz(), 0.0);
   rig.send_motion_after(20ms);
   EXPECT_EQ(rig.driver.id_stats(0x221).count, 1U);
-  EXPECT_EQ(rig.driver.id_stats(0x221).rate_hz, 0.0);
+  EXPECT_EQ(rig.driver.id_stats(0x221).rate_hz(), 0.0);
   rig.send_motion_after(10ms);
-  EXPECT_NEAR(rig.driver.id_stats(0x221).rate_hz, 100.0, 1e-6);
+  EXPECT_NEAR(rig.driver.id_stats(0x221).rate_hz(), 100.0, 1e-6);
 }
