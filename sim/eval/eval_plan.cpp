@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cstdlib>
+#include <numbers>
 
 namespace eval {
 
@@ -123,10 +124,24 @@ std::optional<std::vector<Case>> expand_cases(const std::string& name, int rando
       return std::vector<Case>{c};
     }
   }
+  // The random world of the same seed with gentler turns: up to +-D degrees, taken no faster
+  // than R rad/s (3 when not given), as the recorded pedestrians turn (thirty-seventh session).
+  if (name.rfind("turns-", 0) == 0) {
+    const auto x = name.find('x', 6);
+    const std::string degrees = name.substr(6, x == std::string::npos ? x : x - 6);
+    double d = 0, r = 3.0;
+    const bool rate_ok = x == std::string::npos || parse_number(name.substr(x + 1), r);
+    if (rate_ok && parse_number(degrees, d) && d >= 0 && d <= 180 && r >= 0.2 && r <= 10) {
+      Case c = random_case(name);
+      c.random.max_turn_rad = d * std::numbers::pi / 180.0;
+      c.random.corner_turn_rate_radps = r;
+      return std::vector<Case>{c};
+    }
+  }
   error = fmt::format(
       "unknown case '{}': a scenario (open, static_obstacle, pedestrian_front_right, corridor, "
       "doorway, crossing, random, dead_end), a group (paper, crowds, speeds, sizes, constrained), "
-      "or crowd-N, speed-V, size-AxB, clutter-C",
+      "or crowd-N, speed-V, size-AxB, clutter-C, turns-D[xR]",
       name);
   return std::nullopt;
 }

@@ -30,7 +30,8 @@ struct Case {
 };
 
 // Case names: the built-ins (open ... crossing, random, dead_end), "crowd-N", "speed-V",
-// "size-AxB", "clutter-C" (obstacles beside the walk, C m from it), "paper" (scenarios 1-6 +
+// "size-AxB", "clutter-C" (obstacles beside the walk, C m from it), "turns-D[xR]" (the
+// person's turns up to +-D degrees, at most R rad/s), "paper" (scenarios 1-6 +
 // random), "crowds" (5/10/15/20), "speeds" (0.75/1.2/1.7), "sizes" (a few a x b), "constrained"
 // (clutter 1.2/1.0/0.8 and dead_end). Random and dead_end cases get `random_trials` seeds.
 // Unknown names: nullopt and `error`.

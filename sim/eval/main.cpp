@@ -150,7 +150,7 @@ int run(int argc, char** argv) {
   app.add_option("--case", case_names,
                  "cases: open static_obstacle pedestrian_front_right corridor doorway crossing "
                  "random dead_end | paper crowds speeds sizes constrained | crowd-N speed-V "
-                 "size-AxB clutter-C")
+                 "size-AxB clutter-C turns-D[xR]")
       ->delimiter(',');
   app.add_option("--method", method_names,
                  "methods: objective fixed_behind fixed_side pid policy (policy needs a policy "

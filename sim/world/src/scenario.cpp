@@ -220,15 +220,28 @@ std::optional<Scenario> make_scenario(const std::string& name, uint32_t seed) {
 Scenario random_scenario(uint32_t seed, const RandomScenarioOptions& o) {
   std::mt19937 rng(seed);
   const double speed = uniform(rng, o.speed_min_mps, o.speed_max_mps);
-  // The person's walk: legs of 4-8 m with turns up to +-100 degrees, inside a 24 m square.
+  // The person's walk: legs of 4-8 m with turns up to +-max_turn_rad (100 degrees), inside a
+  // 24 m square.
   std::vector<Waypoint> pts{{{0, 0}}};
   double heading = 0;
   double t = kBuiltInStartDelayS;
   core::Point2 p{0, 0};
+  // Bounds below 90 degrees would meet the square's edge and turn there by 90 degrees and more
+  // (below): such walks steer back toward the middle, more the nearer the edge, within the bound.
+  const bool gentle = o.max_turn_rad < std::numbers::pi / 2;
   while (t < o.duration_s - kTailS) {
     for (int attempt = 0; attempt < 20; ++attempt) {
-      const double turn = uniform(rng, -1.75, 1.75);
-      const double len = uniform(rng, 4.0, 8.0);
+      // The same draw for any bound (the default's walks bit for bit as before it existed).
+      double turn = uniform(rng, -o.max_turn_rad, o.max_turn_rad);
+      double len = uniform(rng, 4.0, 8.0);
+      if (gentle) {
+        // Half-length legs (a turn-round fits in the square), and beyond 2 m from the middle
+        // a pull toward it, whole from 6 m.
+        len /= 2;
+        const double pull = std::clamp((std::hypot(p.x_m, p.y_m) - 2.0) / 4.0, 0.0, 1.0);
+        const double to_centre = core::wrap_angle(std::atan2(-p.y_m, -p.x_m) - heading);
+        turn = std::clamp(turn + pull * to_centre, -o.max_turn_rad, o.max_turn_rad);
+      }
       const core::Point2 q{p.x_m + len * std::cos(heading + turn),
                            p.y_m + len * std::sin(heading + turn)};
       if (std::abs(q.x_m) < 12 && std::abs(q.y_m) < 12) {
@@ -242,7 +255,8 @@ Scenario random_scenario(uint32_t seed, const RandomScenarioOptions& o) {
     }
   }
   Scenario s = base_scenario("random", "random static obstacles and pedestrians", pts,
-                             CornerLimits{.start_stop_accel_mps2 = o.start_stop_accel_mps2});
+                             CornerLimits{.turn_rate_radps = o.corner_turn_rate_radps,
+                                          .start_stop_accel_mps2 = o.start_stop_accel_mps2});
   s.name = fmt::format("random-{}", seed);
   s.duration_s = std::min(s.duration_s, o.duration_s);
   // Static obstacles: circles and boxes at least 1.6 m from the person's walk and the start.

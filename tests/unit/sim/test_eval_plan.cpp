@@ -1,9 +1,14 @@
 // companion-eval's plan: case names -> world recipes, methods -> daemon configuration.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <utility>
+#include <vector>
 
+#include "core/geometry/pose2.hpp"
 #include "eval_plan.hpp"
 #include "firmware/config/config_loader.hpp"
 
@@ -45,9 +50,23 @@ TEST(EvalPlan, GroupsExpandToTheReferenceCases) {
   for (const auto& c : *paper)
     EXPECT_NE(c.name, "dead_end") << "not one of the paper's 1-7";
   EXPECT_EQ(paper->back().random.beside_walk_clearance_m, 0) << "the benchmark stays as it was";
+  EXPECT_EQ(paper->back().random.max_turn_rad, 1.75) << "the benchmark's turns, +-100 degrees";
+  EXPECT_EQ(paper->back().random.corner_turn_rate_radps, 3.0);
+
+  auto gentle = eval::expand_cases("turns-30x1", 3, error);
+  ASSERT_TRUE(gentle);
+  EXPECT_EQ(gentle->front().name, "turns-30x1");
+  EXPECT_EQ(gentle->front().trials, 3);
+  EXPECT_NEAR(gentle->front().random.max_turn_rad, 0.5236, 1e-4);
+  EXPECT_EQ(gentle->front().random.corner_turn_rate_radps, 1.0);
+  auto turns_only = eval::expand_cases("turns-45", 3, error);
+  ASSERT_TRUE(turns_only);
+  EXPECT_NEAR(turns_only->front().random.max_turn_rad, 0.7854, 1e-4);
+  EXPECT_EQ(turns_only->front().random.corner_turn_rate_radps, 3.0) << "the benchmark's rate";
 
   for (const char* bad : {"moon", "crowd-x", "speed-0", "size-1.2", "size-9x9", "crowd-1000",
-                          "clutter-0.2", "clutter-", "clutter-1m"}) {
+                          "clutter-0.2", "clutter-", "clutter-1m", "turns-", "turns-200",
+                          "turns-30x0", "turns-30x", "turns-x1", "turns-30y1"}) {
     EXPECT_FALSE(eval::expand_cases(bad, 3, error)) << bad;
     EXPECT_NE(error.find("unknown case"), std::string::npos);
   }
@@ -154,4 +173,71 @@ TEST(EvalPlan, ConstrainedWorldsAreTheSeedsWorldWithObstaclesBesideTheWalk) {
   }
   EXPECT_LT(open_closed / 10, 0.02) << "the benchmark's worlds hardly close the points beside";
   EXPECT_GT(tight_closed / 10, 0.25) << "a constrained world closes them on much of the walk";
+}
+
+namespace {
+struct WalkTurns {
+  double max_rate_radps = 0;  // the person's largest heading rate while walking
+  int windows = 0;            // 2 s windows walked all through
+  int windows_over_90 = 0;    // ... in which the heading turned more than 90 degrees
+};
+// From the walk's 50 ms samples, counting only while the person walks (faster than 0.5 m/s).
+WalkTurns walk_turns(const sim::Scenario& s) {
+  const auto& samples = s.person.samples();
+  WalkTurns out;
+  std::vector<bool> walking(samples.size(), false);
+  for (size_t k = 1; k < samples.size(); ++k) {
+    const auto& a = samples[k - 1];
+    const auto& b = samples[k];
+    const double dt = b.t_s - a.t_s;
+    const double moved = std::hypot(b.pose.x_m - a.pose.x_m, b.pose.y_m - a.pose.y_m);
+    if (dt <= 0 || moved / dt < 0.5) continue;
+    walking[k] = true;
+    const double rate = std::abs(core::wrap_angle(b.pose.theta_rad - a.pose.theta_rad)) / dt;
+    out.max_rate_radps = std::max(out.max_rate_radps, rate);
+  }
+  constexpr size_t kWindow = 40;  // 2 s of 50 ms samples
+  for (size_t k = kWindow; k < samples.size(); ++k) {
+    if (!std::all_of(walking.begin() + static_cast<long>(k - kWindow) + 1,
+                     walking.begin() + static_cast<long>(k) + 1, [](bool w) { return w; })) {
+      continue;
+    }
+    ++out.windows;
+    const double turned =
+        core::wrap_angle(samples[k].pose.theta_rad - samples[k - kWindow].pose.theta_rad);
+    if (std::abs(turned) > std::numbers::pi / 2) ++out.windows_over_90;
+  }
+  return out;
+}
+}  // namespace
+
+TEST(EvalPlan, GentleTurnsBoundTheWalksTurnsAndKeepItInTheSquare) {
+  std::string error;
+  const auto sharp = eval::expand_cases("random", 1, error)->front();
+  const auto gentle = eval::expand_cases("turns-30x1", 1, error)->front();
+  WalkTurns a_all, b_all;
+  for (uint32_t seed = 1; seed <= 20; ++seed) {
+    const sim::Scenario a = eval::make_world(sharp, seed);
+    const sim::Scenario b = eval::make_world(gentle, seed);
+    EXPECT_EQ(b.name, fmt::format("turns-30x1-{}", seed));
+    const WalkTurns at = walk_turns(a);
+    const WalkTurns bt = walk_turns(b);
+    EXPECT_LE(bt.max_rate_radps, 1.0 + 1e-6) << "seed " << seed << ": corners at 1 rad/s at most";
+    a_all.max_rate_radps = std::max(a_all.max_rate_radps, at.max_rate_radps);
+    a_all.windows += at.windows;
+    a_all.windows_over_90 += at.windows_over_90;
+    b_all.windows += bt.windows;
+    b_all.windows_over_90 += bt.windows_over_90;
+    for (const auto& tp : b.person.samples()) {
+      ASSERT_LT(std::max(std::abs(tp.pose.x_m), std::abs(tp.pose.y_m)), 12.0) << seed;
+    }
+    // The same seed's pedestrians: only the person's walk (and what stands clear of it) differs.
+    ASSERT_EQ(a.pedestrians.size(), b.pedestrians.size());
+  }
+  EXPECT_GT(a_all.max_rate_radps, 2.9) << "the benchmark's corners at 3 rad/s";
+  const double sharp_share = 1.0 * a_all.windows_over_90 / a_all.windows;
+  const double gentle_share = 1.0 * b_all.windows_over_90 / b_all.windows;
+  EXPECT_GT(sharp_share, 0.05) << "the benchmark turns more than 90 degrees in 2 s often";
+  // A gentle walk only where it meets the square's edge and turns round at 1 rad/s.
+  EXPECT_LT(gentle_share, 0.02);
 }

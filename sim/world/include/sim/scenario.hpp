@@ -60,6 +60,14 @@ struct RandomScenarioOptions {
   // inflation up to R); near 0.8 m the point behind at corners. They come on top of the
   // seed's world, which stays as it is (walk, obstacles, pedestrians), so cases pair by seed.
   double beside_walk_clearance_m = 0;
+  // The person's turns at the legs' ends: up to +-max_turn_rad (one uniform draw scaled to it,
+  // so a smaller bound scales the same seed's turns down), walked on arcs no faster than
+  // corner_turn_rate_radps; bounds below 90 degrees walk 2-4 m legs and are pulled toward the
+  // middle, so that they turn round before the edge. The benchmark's walks: +-100 deg at 3 rad/s;
+  // the recorded pedestrians of sim/data/pedestrians turn far less (docs/EVALUATION.md,
+  // thirty-seventh session: companion-eval's `turns-D` cases).
+  double max_turn_rad = 1.75;
+  double corner_turn_rate_radps = 3.0;
 };
 Scenario random_scenario(uint32_t seed, const RandomScenarioOptions& options);
 

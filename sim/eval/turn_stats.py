@@ -1,0 +1,177 @@
+#!/usr/bin/python3
+"""How sharply people turn: recorded pedestrians against the simulated person's walks.
+
+    sim/eval/turn_stats.py [--period-s 0.4] [--walking-mps 0.5] [--window-s 2] SOURCE...
+
+A SOURCE is a recorded-pedestrian file (`frame id x y`, the format of sim/data/pedestrians/, one
+frame step taken as --period-s; every person's track, split where they are not observed for a
+frame) or the sample files of `companion-eval --samples` (a directory, or files named one by one,
+which make one row together; the person's true track of each trial; `-world.csv` files skipped).
+Every track is looked at the same way, as the recorded files are made: positions every
+--period-s (the samples taken at that period), the heading from the central difference of two
+positions --period-s either side, counted only while the walker moves faster than
+--walking-mps. Sampled this coarsely a quick turn reads slower than it was walked; both sources
+read alike, which is the point of the comparison.
+
+Prints a Markdown table, one row per source: the walking time, the median speed, the heading
+rate's p50 / p90 / p99 and the share of the time above 0.5 and 1 rad/s, and the heading change
+over the --window-s windows walked all through (p50 / p90 / p99, the share above 45 and 90
+degrees). Standard library only.
+"""
+import argparse
+import collections
+import glob
+import math
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import eval_samples  # noqa: E402
+
+FRAMES_PER_GAP = 1.5  # a track is split where two observations are more than this many frames apart
+
+
+def wrap(a):
+    return (a + math.pi) % (2 * math.pi) - math.pi
+
+
+def read_recorded(path):
+    """Tracks of a `frame id x y` file: lists of (x, y), one observation per frame step."""
+    people = collections.defaultdict(list)
+    with open(path) as f:
+        for number, line in enumerate(f, 1):
+            cols = line.split()
+            if not cols:
+                continue
+            bad = ValueError(f"{path}:{number}: expected 'frame id x y', got {line.strip()!r}")
+            try:
+                frame, pid, x, y = (float(c) for c in cols[:4]) if len(cols) >= 4 else [math.nan]*4
+            except ValueError:
+                raise bad from None
+            if not all(map(math.isfinite, (frame, pid, x, y))):
+                raise bad
+            people[pid].append((frame, x, y))
+    frames = sorted({o[0] for track in people.values() for o in track})
+    steps = [b - a for a, b in zip(frames, frames[1:]) if b > a]
+    step = min(steps) if steps else 1.0
+    tracks = []
+    for observations in people.values():
+        observations.sort()
+        current = []
+        for k, (frame, x, y) in enumerate(observations):
+            if k and frame - observations[k - 1][0] > FRAMES_PER_GAP * step:
+                tracks.append(current)
+                current = []
+            current.append((x, y))
+        tracks.append(current)
+    return tracks
+
+
+def read_samples(path, period_s):
+    """The person's true track of one companion-eval sample file, every period_s."""
+    track, next_s = [], 0.0
+    for row in eval_samples.read_rows(path):
+        t = float(row["t_s"])
+        if t + 1e-6 >= next_s:
+            track.append((float(row["person_x_m"]), float(row["person_y_m"])))
+            next_s += period_s
+    return track
+
+
+def turn_statistics(tracks, period_s, walking_mps, window_s):
+    """Heading rates (rad/s) and window turns (rad) of tracks sampled every period_s."""
+    rates, turns, speeds = [], [], []
+    window = max(1, round(window_s / period_s))
+    for track in tracks:
+        headings = []  # (heading, speed) at every inner sample
+        for k in range(1, len(track) - 1):
+            vx = (track[k + 1][0] - track[k - 1][0]) / (2 * period_s)
+            vy = (track[k + 1][1] - track[k - 1][1]) / (2 * period_s)
+            headings.append((math.atan2(vy, vx), math.hypot(vx, vy)))
+        walking = [speed > walking_mps for _, speed in headings]
+        for k in range(len(headings) - 1):
+            if walking[k] and walking[k + 1]:
+                rates.append(abs(wrap(headings[k + 1][0] - headings[k][0])) / period_s)
+                speeds.append(headings[k][1])
+        for k in range(len(headings) - window):
+            if all(walking[k:k + window + 1]):
+                turns.append(abs(wrap(headings[k + window][0] - headings[k][0])))
+    return rates, turns, speeds
+
+
+def percentile(values, q):
+    """The nearest-rank percentile of values (q in 0..100)."""
+    ordered = sorted(values)
+    return ordered[min(len(ordered) - 1, max(0, math.ceil(q / 100 * len(ordered)) - 1))]
+
+
+def row(label, rates, turns, speeds, period_s):
+    if not rates or not turns:
+        return f"| {label} | 0.0 | - | - | - | - | - | - | - | - |"
+
+    def share(values, above):
+        return 100.0 * sum(v > above for v in values) / len(values)
+    deg = [math.degrees(t) for t in turns]
+    return (f"| {label} | {len(rates) * period_s / 60:.1f} | {percentile(speeds, 50):.2f} | "
+            f"{percentile(rates, 50):.2f} / {percentile(rates, 90):.2f} / "
+            f"{percentile(rates, 99):.2f} | {share(rates, 0.5):.1f} | {share(rates, 1.0):.1f} | "
+            f"{percentile(deg, 50):.0f} / {percentile(deg, 90):.0f} / {percentile(deg, 99):.0f} | "
+            f"{share(deg, 45):.1f} | {share(deg, 90):.1f} |")
+
+
+def sources(paths):
+    """(label, kind, files): one per recorded file and per sample directory; the sample files
+    named one by one (a shell glob) make one source together. World files are skipped."""
+    out, loose = [], []
+    for p in paths:
+        if os.path.isdir(p):
+            files = sorted(f for f in glob.glob(os.path.join(p, "*.csv"))
+                           if not f.endswith("-world.csv"))
+            out.append((p, "samples", files))
+        elif p.endswith(".csv"):
+            if not p.endswith("-world.csv"):
+                loose.append(p)
+        else:
+            out.append((p, "recorded", [p]))
+    if loose:
+        out.append((os.path.commonpath(loose) if len(loose) > 1 else loose[0], "samples", loose))
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("paths", nargs="+", help="recorded-pedestrian files, sample directories/files")
+    ap.add_argument("--period-s", type=float, default=0.4)
+    ap.add_argument("--walking-mps", type=float, default=0.5)
+    ap.add_argument("--window-s", type=float, default=2.0)
+    args = ap.parse_args()
+    for name in ("period_s", "walking_mps", "window_s"):
+        value = getattr(args, name)
+        if not math.isfinite(value) or value < 0 or (name != "walking_mps" and value == 0):
+            ap.error(f"--{name.replace('_', '-')} must be a finite number > 0, not {value}")
+    w = f"{args.window_s:g} s"
+    print(f"| source | walking min | speed p50 m/s | heading rate p50 / p90 / p99 rad/s | "
+          f"> 0.5 rad/s % | > 1 rad/s % | turn in {w} p50 / p90 / p99 deg | "
+          f"> 45 deg in {w} % | > 90 deg in {w} % |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for label, kind, files in sources(args.paths):
+        if not files:
+            sys.exit(f"turn_stats: no sample files in {label}")
+        try:
+            if kind == "recorded":
+                tracks = read_recorded(files[0])
+            else:
+                tracks = [read_samples(f, args.period_s) for f in files]
+        except OSError as err:
+            sys.exit(f"turn_stats: {err}")
+        except (KeyError, ValueError) as err:
+            sys.exit(f"turn_stats: {label}: {err}")
+        stats = turn_statistics(tracks, args.period_s, args.walking_mps, args.window_s)
+        name = os.path.basename(label.rstrip("/")) if kind == "recorded" else label
+        if kind == "samples":
+            name += f" ({len(files)} trials)"
+        print(row(name, *stats, args.period_s))
+
+
+if __name__ == "__main__":
+    main()
