@@ -181,6 +181,7 @@ core::MppiConfig mppi_config(const DaemonConfig& cfg) {
   c.limits =
       core::TwistLimits{cfg.limits.vx_max_mps, cfg.limits.vy_max_mps, cfg.limits.wz_max_radps};
   c.reverse_speed_max_mps = m.reverse_speed_max_mps;
+  c.guide_heading_gain_per_s = m.guide_heading_gain_per_s;
   c.obstacle_speed.robot_decel_mps2 = cfg.obstacle_speed.robot_decel_mps2;
   c.obstacle_speed.reaction_time_s = cfg.obstacle_speed.reaction_time_s;
   c.obstacle_speed.margin_m = cfg.obstacle_speed.margin_m;

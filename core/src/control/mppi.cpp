@@ -150,11 +150,12 @@ void Mppi::prepare_guide_block(const MppiInputs& in) {
     return std::clamp(to, from - step, from + step);
   };
   // The steering law: the world velocity and turn rate of q^d's path plus a pull of 2/s toward
-  // where q^d is at the same step (position and heading), at most `speed` of the box (scaled as a
-  // vector, so the direction holds); every step within the base's accelerations, as the rollouts
-  // will clamp it. (Pulling toward q^d one step later ran the law a step ahead of a walking
-  // person and its half-speed copy behind; the two tied ~5 cm behind and took turns.) With a
-  // carrot (the path sample), the translation tracks the carrot's path instead of q^d's.
+  // where q^d is at the same step (its heading's pull: guide_heading_gain_per_s), at most
+  // `speed` of the box (scaled as a vector, so the direction holds); every step within the
+  // base's accelerations, as the rollouts will clamp it. (Pulling toward q^d one step later ran
+  // the law a step ahead of a walking person and its half-speed copy behind; the two tied ~5 cm
+  // behind and took turns.) With a carrot (the path sample), the translation tracks the carrot's
+  // path instead of q^d's.
   auto law = [&](size_t k, const Pose2& p, const Twist& prev, double speed, const Point2* carrot0,
                  const Point2* carrot1) {
     const TwistLimits box{lim.vx * speed, lim.vy * speed, lim.wz};
@@ -175,7 +176,8 @@ void Mppi::prepare_guide_block(const MppiInputs& in) {
     bx *= scale;
     by *= scale;
     const double bw =
-        std::clamp(wrap_angle(g1.theta - g0.theta) / dt + 2.0 * wrap_angle(g0.theta - p.theta_rad),
+        std::clamp(wrap_angle(g1.theta - g0.theta) / dt +
+                       cfg_.guide_heading_gain_per_s * wrap_angle(g0.theta - p.theta_rad),
                    -box.wz, box.wz);
     return Twist{toward(prev.vx, bx, dv), toward(prev.vy, by, dv), toward(prev.wz, bw, dw)};
   };

@@ -974,6 +974,15 @@ std::vector<FieldSpec> build() {
        0.0,
        3.0,
        {}},
+      {"mppi.guide_heading_gain_per_s",
+       "1/s",
+       "The structured samples' steering law: its pull toward q^d's heading (q^d's turn rate feeds "
+       "forward besides). Those samples are the plan most of the time, so this sets how fast the "
+       "robot answers the person's turn. docs/EVALUATION.md, thirty-seventh session.",
+       FIELD(mppi.guide_heading_gain_per_s),
+       0.5,
+       20.0,
+       {}},
       {"mppi.threads",
        "count",
        "OpenMP threads for the samples (the control task's CPU share).",

@@ -290,6 +290,16 @@ TEST(Config, TheTrackingFrameIsAChoiceThatReachesTheController) {
   EXPECT_EQ(firmware::mppi_config(*r.config).tracking_frame, core::TrackingFrame::kRobot);
 }
 
+TEST(Config, TheSteeringLawsHeadingGainReachesTheControllerAndIsBounded) {
+  EXPECT_DOUBLE_EQ(
+      firmware::mppi_config(*firmware::load_default_config().config).guide_heading_gain_per_s, 2.0);
+  const auto r = load_config_text("mppi:\n  guide_heading_gain_per_s: 6\n", "test.yaml");
+  ASSERT_TRUE(r.ok()) << r.errors[0].to_string();
+  EXPECT_DOUBLE_EQ(firmware::mppi_config(*r.config).guide_heading_gain_per_s, 6.0);
+  expect_error(load_config_text("mppi:\n  guide_heading_gain_per_s: 0\n", "test.yaml"), 2,
+               "mppi.guide_heading_gain_per_s", "out of range [0.5, 20]");
+}
+
 TEST(Config, ThePlansReverseLimitReachesTheControllerAndIsBounded) {
   EXPECT_DOUBLE_EQ(
       firmware::mppi_config(*firmware::load_default_config().config).reverse_speed_max_mps, 1.8)

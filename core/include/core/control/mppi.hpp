@@ -106,6 +106,11 @@ struct MppiConfig {
   // the robot stays on the side it first took, with q^d across the person (the fixed_side
   // baseline's e_y of ~1 m).
   double orbit_trigger_radius = 0.85;
+  // The steering law's pull toward q^d's heading (1/s; its turn rate feeds forward besides): 2
+  // turns a 0.5 rad lag back at 1 rad/s. With the structured samples the plan most of the time
+  // (~87 % of the control steps on the random worlds), this is how fast the robot answers a
+  // person's turn (docs/EVALUATION.md, thirty-seventh session).
+  double guide_heading_gain_per_s = 2.0;
   double orbit_radius = 1.15;
   double orbit_speed_mps = 1.0;
   bool orbit_guide = false;  // (after its parameters: beside `threads`, no padding)

@@ -157,6 +157,7 @@ struct DaemonConfig {
     double noise_wz_radps = 0;
     double terminal_weight = 0;
     double reverse_speed_max_mps = 0;
+    double guide_heading_gain_per_s = 0;
     int64_t threads = 0;
     int64_t seed = 0;
   } mppi;
