@@ -25,7 +25,6 @@ the steady samples only. e as eval_samples.py computes it (the true poses;
 e_θ against the person's heading). Standard library only.
 """
 import argparse
-import glob
 import math
 import os
 import sys
@@ -71,14 +70,6 @@ def classify(rows, window_s, jump_m, turn_rad_s, pedestrian_m):
             event = EVENTS[3]
         out.append((event, e))
     return out
-
-
-def sample_files(paths):
-    files = []
-    for p in paths:
-        found = sorted(glob.glob(os.path.join(p, "*.csv"))) if os.path.isdir(p) else [p]
-        files += [f for f in found if not f.endswith("-world.csv")]
-    return files
 
 
 def table(classified):
@@ -136,7 +127,7 @@ def main():
         value = getattr(args, name)
         if not math.isfinite(value) or value < 0:
             ap.error(f"--{name.replace('_', '-')} must be a finite number >= 0, not {value}")
-    files = sample_files(args.paths)
+    files = eval_samples.sample_files(args.paths)
     if not files:
         sys.exit(f"error_sources: no sample files in {' '.join(args.paths)}")
     trials = []

@@ -1,12 +1,14 @@
 """A trial's sample file (companion-eval --samples) read as tracking errors.
 
-Shared by plot_eval.py (errors over time) and heading_bound.py (the e_theta bound), so that both
-compute e = q^d - robot the same way as each other. Standard library only: importing it loads
+Shared by plot_eval.py (errors over time), heading_bound.py (the e_theta bound), error_sources.py
+and turn_stats.py, so that all compute e = q^d - robot and find the sample files the same way. Standard library only: importing it loads
 neither matplotlib nor numpy.
 """
 import collections
 import csv
+import glob
 import math
+import os
 
 TrackedSample = collections.namedtuple(
     "TrackedSample", "t_s robot_theta_rad person_theta_rad ex_m ey_m etheta_rad")
@@ -20,6 +22,15 @@ def wrap(angle_rad):
 def read_rows(path):
     with open(path, newline="") as f:
         return list(csv.DictReader(f))
+
+
+def sample_files(paths):
+    """The trials' sample files of directories and files, without the -world.csv beside them."""
+    files = []
+    for p in paths:
+        found = sorted(glob.glob(os.path.join(p, "*.csv"))) if os.path.isdir(p) else [p]
+        files += [f for f in found if not f.endswith("-world.csv")]
+    return files
 
 
 def tracking_errors(rows):

@@ -20,7 +20,6 @@ degrees). Standard library only.
 """
 import argparse
 import collections
-import glob
 import math
 import os
 import sys
@@ -125,12 +124,9 @@ def sources(paths):
     out, loose = [], []
     for p in paths:
         if os.path.isdir(p):
-            files = sorted(f for f in glob.glob(os.path.join(p, "*.csv"))
-                           if not f.endswith("-world.csv"))
-            out.append((p, "samples", files))
+            out.append((p, "samples", eval_samples.sample_files([p])))
         elif p.endswith(".csv"):
-            if not p.endswith("-world.csv"):
-                loose.append(p)
+            loose += eval_samples.sample_files([p])
         else:
             out.append((p, "recorded", [p]))
     if loose:
