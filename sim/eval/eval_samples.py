@@ -1,8 +1,8 @@
 """A trial's sample file (companion-eval --samples) read as tracking errors.
 
 Shared by plot_eval.py (errors over time), heading_bound.py (the e_theta bound), error_sources.py
-and turn_stats.py, so that all compute e = q^d - robot and find the sample files the same way. Standard library only: importing it loads
-neither matplotlib nor numpy.
+and turn_stats.py, so that all compute e = q^d - robot and find the sample files the same way.
+Standard library only: importing it loads neither matplotlib nor numpy.
 """
 import collections
 import csv

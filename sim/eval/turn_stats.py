@@ -30,10 +30,6 @@ import eval_samples  # noqa: E402
 FRAMES_PER_GAP = 1.5  # a track is split where two observations are more than this many frames apart
 
 
-def wrap(a):
-    return (a + math.pi) % (2 * math.pi) - math.pi
-
-
 def read_recorded(path):
     """Tracks of a `frame id x y` file: lists of (x, y), one observation per frame step."""
     people = collections.defaultdict(list)
@@ -90,16 +86,17 @@ def turn_statistics(tracks, period_s, walking_mps, window_s):
         walking = [speed > walking_mps for _, speed in headings]
         for k in range(len(headings) - 1):
             if walking[k] and walking[k + 1]:
-                rates.append(abs(wrap(headings[k + 1][0] - headings[k][0])) / period_s)
+                rates.append(abs(eval_samples.wrap(headings[k + 1][0] - headings[k][0])) / period_s)
                 speeds.append(headings[k][1])
         for k in range(len(headings) - window):
             if all(walking[k:k + window + 1]):
-                turns.append(abs(wrap(headings[k + window][0] - headings[k][0])))
+                turns.append(abs(eval_samples.wrap(headings[k + window][0] - headings[k][0])))
     return rates, turns, speeds
 
 
 def percentile(values, q):
-    """The nearest-rank percentile of values (q in 0..100)."""
+    """The nearest-rank percentile of values (q in 0..100): always one of the values, unlike
+    statistics.quantiles, which interpolates (a share of turns at 0 and 2 rad/s would read 0.2)."""
     ordered = sorted(values)
     return ordered[min(len(ordered) - 1, max(0, math.ceil(q / 100 * len(ordered)) - 1))]
 
