@@ -182,6 +182,11 @@ int run(int argc, char** argv) {
   app.add_flag("--person-walks-through", person_walks_through,
                "the followed person keeps to their script even into the robot (default: they "
                "do not walk into it; contacts the robot causes count either way)");
+  bool recorded_walk_through = false;
+  app.add_flag("--recorded-walk-through", recorded_walk_through,
+               "recorded pedestrians keep to their recording even into the robot (default: "
+               "they do not walk into it, as the followed person; the recorded tables up to the "
+               "thirty-seventh session)");
   std::vector<double> costmap_at;
   app.add_option("--costmap-at", costmap_at,
                  "write the daemon's costmap at these times (s) of each trial as map_server maps "
@@ -278,6 +283,7 @@ int run(int argc, char** argv) {
       o.seed = t.seed;
       o.duration_s = duration_s;
       o.person_avoids_robot = !person_walks_through;
+      o.replayed_avoid_robot = !recorded_walk_through;
       if (!costmap_at.empty()) {
         std::filesystem::create_directories(out_dir + "/costmaps");
         o.costmap_at_s = costmap_at;

@@ -126,6 +126,7 @@ SimRunResult run_simulation(const SimRunOptions& o) {
   hal::SystemdNotifier notifier;  // no NOTIFY_SOCKET in a simulation: a no-op
   SimWorldConfig world_cfg = world_config(o.config, o.seed);
   world_cfg.person_avoids_robot = o.person_avoids_robot;
+  world_cfg.replayed_avoid_robot = o.replayed_avoid_robot;
   SimWorld world(o.scenario, world_cfg, clock);
   firmware::DaemonConfig cfg = o.config;
   cfg.mppi.seed = o.seed;

@@ -309,8 +309,9 @@ std::optional<Scenario> recorded_scenario(const PedestrianDataset& dataset, int 
   }
   // Time shifted so the followed person appears at kBuiltInStartDelayS (the daemon arms meanwhile).
   const double shift = kBuiltInStartDelayS - followed.start_s();
+  // Walked smoothly between the 2.5 Hz observations (sim/trajectory.hpp: smooth_track).
   auto shifted = [&](const Trajectory& tr) {
-    std::vector<TimedPose> out = tr.samples();
+    std::vector<TimedPose> out = smooth_track(tr).samples();
     for (TimedPose& s : out)
       s.t_s += shift;
     return Trajectory(std::move(out));

@@ -101,11 +101,8 @@ std::vector<Point2> SimWorld::pedestrian_positions() const {
   std::vector<Point2> out;
   for (const Pedestrian& p : crowd_.people())
     out.push_back(p.position);
-  for (const Trajectory& r : scenario_.replayed) {
-    if (t_s_ >= r.start_s() && t_s_ <= r.end_s()) {
-      const auto q = r.pose_at(t_s_);
-      out.push_back({q.x_m, q.y_m});
-    }
+  for (const auto& w : replayed_) {
+    if (w) out.push_back(w->at);
   }
   return out;
 }
@@ -127,21 +124,49 @@ void SimWorld::move_person(double t_s, double dt_s) {
     person_velocity_ = scenario_.person.velocity_at(t_s);
     return;
   }
-  const Point2 from{person_.x_m, person_.y_m};
+  const ScriptedWalker w =
+      step_clear_of_robot({{person_.x_m, person_.y_m}, person_offset_, person_velocity_}, scripted,
+                          scenario_.person_radius_m, dt_s);
+  person_offset_ = w.offset;
+  person_velocity_ = w.velocity;
+  person_ = {w.at.x_m, w.at.y_m, scripted.theta_rad};
+}
+
+void SimWorld::move_replayed(double t_s, double dt_s) {
+  replayed_.resize(scenario_.replayed.size());
+  for (size_t i = 0; i < scenario_.replayed.size(); ++i) {
+    const Trajectory& r = scenario_.replayed[i];
+    std::optional<ScriptedWalker>& w = replayed_[i];
+    if (t_s < r.start_s() || t_s > r.end_s()) {
+      w.reset();
+      continue;
+    }
+    const core::Pose2 scripted = r.pose_at(t_s);
+    if (!w || !config_.replayed_avoid_robot || dt_s <= 0) {
+      w = ScriptedWalker{{scripted.x_m, scripted.y_m}, {}, r.velocity_at(t_s)};
+      continue;
+    }
+    w = step_clear_of_robot(*w, scripted, kReplayedRadiusM, dt_s);
+  }
+}
+
+SimWorld::ScriptedWalker SimWorld::step_clear_of_robot(const ScriptedWalker& w,
+                                                       const core::Pose2& scripted, double radius_m,
+                                                       double dt_s) const {
+  const Point2 from = w.at;
   // Back toward the path, at most person_return_mps.
-  Point2 offset = person_offset_;
+  Point2 offset = w.offset;
   const double off_m = std::hypot(offset.x_m, offset.y_m);
   if (off_m > 0) {
     const double keep = std::max(off_m - config_.person_return_mps * dt_s, 0.0) / off_m;
     offset = {offset.x_m * keep, offset.y_m * keep};
   }
   Point2 to{scripted.x_m + offset.x_m, scripted.y_m + offset.y_m};
-  const double r = scenario_.person_radius_m;
   const double margin = config_.person_contact_margin_m;
-  const double gap_from = footprint_distance(from) - r;
-  const double gap_to = footprint_distance(to) - r;
+  const double gap_from = footprint_distance(from) - radius_m;
+  const double gap_to = footprint_distance(to) - radius_m;
   if (gap_to < margin && gap_to < gap_from) {
-    // The outward normal of the footprint at the person (base_link's box, then the world).
+    // The outward normal of the footprint at the walker (base_link's box, then the world).
     const core::Pose2 robot = robot_pose();
     const Point2 q = robot.inverse().apply(from);
     const Point2 c{std::clamp(q.x_m, config_.footprint_x_min_m, config_.footprint_x_max_m),
@@ -179,19 +204,20 @@ void SimWorld::move_person(double t_s, double dt_s) {
     // Nor into a wall while sliding, nor closer to the robot than they were.
     const double wall_to = scenario_.world.distance(to);
     constexpr double kSlideToleranceM = 1e-6;  // sliding along a side keeps the gap, to rounding
-    if (footprint_distance(to) - r < std::min(margin, gap_from) - kSlideToleranceM ||
-        (wall_to < r && wall_to < scenario_.world.distance(from))) {
+    if (footprint_distance(to) - radius_m < std::min(margin, gap_from) - kSlideToleranceM ||
+        (wall_to < radius_m && wall_to < scenario_.world.distance(from))) {
       to = from;
     }
   }
-  person_offset_ = {to.x_m - scripted.x_m, to.y_m - scripted.y_m};
-  person_velocity_ = {(to.x_m - from.x_m) / dt_s, (to.y_m - from.y_m) / dt_s};
-  person_ = {to.x_m, to.y_m, scripted.theta_rad};
+  return {to,
+          {to.x_m - scripted.x_m, to.y_m - scripted.y_m},
+          {(to.x_m - from.x_m) / dt_s, (to.y_m - from.y_m) / dt_s}};
 }
 
 void SimWorld::advance(double t_s) {
   const double dt = t_s - t_s_;
   move_person(t_s, dt);
+  move_replayed(t_s, dt);
   if (dt > 0) {
     const core::Pose2 robot = robot_pose();
     const auto& v = base_->velocity();
@@ -199,10 +225,8 @@ void SimWorld::advance(double t_s) {
     bodies_.clear();
     bodies_.push_back({{person_.x_m, person_.y_m}, person_velocity_, scenario_.person_radius_m});
     bodies_.push_back({{robot.x_m, robot.y_m}, v_world, config_.robot_avoid_radius_m});
-    for (const Trajectory& r : scenario_.replayed) {
-      if (t_s < r.start_s() || t_s > r.end_s()) continue;
-      const auto q = r.pose_at(t_s);
-      bodies_.push_back({{q.x_m, q.y_m}, r.velocity_at(t_s), kReplayedRadiusM});
+    for (const auto& w : replayed_) {
+      if (w) bodies_.push_back({w->at, w->velocity, kReplayedRadiusM});
     }
     crowd_.step(dt, scenario_.world, bodies_);
   }
@@ -242,10 +266,8 @@ void SimWorld::step(hal::Nanos now) {
     cylinders_.push_back({{person_.x_m, person_.y_m}, scenario_.person_radius_m, 1.75});
     for (const Pedestrian& p : crowd_.people())
       cylinders_.push_back({p.position, p.radius_m, 1.75});
-    for (const Trajectory& r : scenario_.replayed) {
-      if (t_s_ < r.start_s() || t_s_ > r.end_s()) continue;
-      const auto q = r.pose_at(t_s_);
-      cylinders_.push_back({{q.x_m, q.y_m}, kReplayedRadiusM, 1.75});
+    for (const auto& w : replayed_) {
+      if (w) cylinders_.push_back({w->at, kReplayedRadiusM, 1.75});
     }
     lidar_.step(
         last_step_, scenario_.world, cylinders_, [this](hal::Nanos t) { return robot_at(t); },
@@ -306,10 +328,8 @@ double SimWorld::footprint_clearance_people() const {
   double best = footprint_distance({person_.x_m, person_.y_m}) - scenario_.person_radius_m;
   for (const Pedestrian& p : crowd_.people())
     best = std::min(best, footprint_distance(p.position) - p.radius_m);
-  for (const Trajectory& r : scenario_.replayed) {
-    if (t_s_ < r.start_s() || t_s_ > r.end_s()) continue;
-    const auto q = r.pose_at(t_s_);
-    best = std::min(best, footprint_distance({q.x_m, q.y_m}) - kReplayedRadiusM);
+  for (const auto& w : replayed_) {
+    if (w) best = std::min(best, footprint_distance(w->at) - kReplayedRadiusM);
   }
   return std::max(best, 0.0);
 }

@@ -56,6 +56,83 @@ void set_headings_from_motion(std::vector<TimedPose>& samples) {
   if (!samples.empty()) samples.back().pose.theta_rad = heading;
 }
 
+namespace {
+
+// The walker's velocity at each observation for a cubic Hermite curve through them: the
+// derivative of the parabola through it and its two neighbours (Catmull-Rom's for uneven
+// steps), so a corner is cut as walkers cut it and a straight walk at one speed stays exactly
+// that. Its length is held to 3 times the slower of the two neighbouring chords' speeds
+// (Fritsch and Carlson's bound, taken along the path): a person who stops (one chord of about
+// 0 m/s) has about no velocity where they stop, so the curve does not carry them on past it
+// and back, which would turn their heading round. The ends take their one chord.
+std::vector<core::Point2> observation_velocities(const std::vector<TimedPose>& obs) {
+  const size_t n = obs.size();
+  std::vector<core::Point2> chord(n - 1);  // m/s
+  for (size_t k = 0; k + 1 < n; ++k) {
+    const double h = obs[k + 1].t_s - obs[k].t_s;
+    chord[k] = {(obs[k + 1].pose.x_m - obs[k].pose.x_m) / h,
+                (obs[k + 1].pose.y_m - obs[k].pose.y_m) / h};
+  }
+  std::vector<core::Point2> v(n);
+  v.front() = chord.front();
+  v.back() = chord.back();
+  for (size_t k = 1; k + 1 < n; ++k) {
+    const double h0 = obs[k].t_s - obs[k - 1].t_s;
+    const double h1 = obs[k + 1].t_s - obs[k].t_s;
+    const double w0 = h1 / (h0 + h1);  // the nearer neighbour's chord counts more
+    const double w1 = h0 / (h0 + h1);
+    core::Point2 m{w0 * chord[k - 1].x_m + w1 * chord[k].x_m,
+                   w0 * chord[k - 1].y_m + w1 * chord[k].y_m};
+    const double limit = 3.0 * std::min(std::hypot(chord[k - 1].x_m, chord[k - 1].y_m),
+                                        std::hypot(chord[k].x_m, chord[k].y_m));
+    const double len = std::hypot(m.x_m, m.y_m);
+    if (len > limit) m = {m.x_m * limit / len, m.y_m * limit / len};
+    v[k] = m;
+  }
+  return v;
+}
+
+// The cubic Hermite piece from (y0, slope m0) to (y1, m1) over a step of h, at s in [0, 1].
+double hermite(double y0, double y1, double m0, double m1, double h, double s) {
+  const double s2 = s * s;
+  const double s3 = s2 * s;
+  return (2 * s3 - 3 * s2 + 1) * y0 + (s3 - 2 * s2 + s) * h * m0 + (-2 * s3 + 3 * s2) * y1 +
+         (s3 - s2) * h * m1;
+}
+
+}  // namespace
+
+Trajectory smooth_track(const Trajectory& observed, double step_s) {
+  if (observed.samples().size() < 2 || !(step_s > 0)) return observed;
+  std::vector<TimedPose> obs;
+  for (const TimedPose& o : observed.samples()) {
+    if (obs.empty() || o.t_s > obs.back().t_s) obs.push_back(o);  // times must rise
+  }
+  if (obs.size() < 2) return observed;
+  const std::vector<core::Point2> v = observation_velocities(obs);
+  std::vector<TimedPose> out;
+  size_t k = 0;
+  const double t0 = obs.front().t_s;
+  const auto steps = static_cast<size_t>(std::floor((obs.back().t_s - t0) / step_s + 1e-9));
+  for (size_t i = 0; i <= steps; ++i) {
+    const double t = t0 + static_cast<double>(i) * step_s;
+    while (k + 2 < obs.size() && obs[k + 1].t_s <= t)
+      ++k;
+    const core::Pose2& a = obs[k].pose;
+    const core::Pose2& b = obs[k + 1].pose;
+    const double h = obs[k + 1].t_s - obs[k].t_s;
+    const double s = std::clamp((t - obs[k].t_s) / h, 0.0, 1.0);
+    out.push_back({t,
+                   {hermite(a.x_m, b.x_m, v[k].x_m, v[k + 1].x_m, h, s),
+                    hermite(a.y_m, b.y_m, v[k].y_m, v[k + 1].y_m, h, s), 0.0}});
+  }
+  if (obs.back().t_s - out.back().t_s > 1e-9) {
+    out.push_back({obs.back().t_s, {obs.back().pose.x_m, obs.back().pose.y_m, 0.0}});
+  }
+  set_headings_from_motion(out);
+  return Trajectory(std::move(out));
+}
+
 double path_length(const Trajectory& t) {
   double len = 0;
   const auto& s = t.samples();

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -267,6 +268,90 @@ TEST(Walk, HeadingIsKeptWhileStanding) {
     EXPECT_NEAR(p.pose.theta_rad, 0.0, 1e-9) << "t=" << p.t_s;
 }
 
+namespace {
+// The largest change of velocity (m/s) and of heading (rad) between consecutive steps of
+// `step_s` over the track.
+struct Jumps {
+  double velocity_mps = 0;
+  double heading_rad = 0;
+};
+Jumps largest_jumps(const sim::Trajectory& tr, double step_s) {
+  Jumps j;
+  const auto steps = static_cast<int>((tr.end_s() - tr.start_s()) / step_s);
+  for (int i = 1; i + 1 < steps; ++i) {
+    const double t = tr.start_s() + i * step_s;
+    const Point2 a = tr.velocity_at(t - step_s);
+    const Point2 b = tr.velocity_at(t);
+    j.velocity_mps = std::max(j.velocity_mps, std::hypot(b.x_m - a.x_m, b.y_m - a.y_m));
+    j.heading_rad = std::max(
+        j.heading_rad,
+        std::abs(core::wrap_angle(tr.pose_at(t).theta_rad - tr.pose_at(t - step_s).theta_rad)));
+  }
+  return j;
+}
+}  // namespace
+
+TEST(SmoothTrack, PassesThroughEveryObservationAndTurnsACornerWithoutAJump) {
+  // A 2.5 Hz track (as the ETH/UCY files) of a person walking 1.2 m/s east, then north.
+  std::vector<sim::TimedPose> obs;
+  for (int i = 0; i <= 6; ++i)
+    obs.push_back({0.4 * i, {0.48 * i, 0.0, 0.0}});
+  for (int i = 1; i <= 6; ++i)
+    obs.push_back({0.4 * (6 + i), {2.88, 0.48 * i, 0.0}});
+  sim::set_headings_from_motion(obs);
+  const sim::Trajectory raw(obs);
+  const sim::Trajectory smooth = sim::smooth_track(raw);
+  ASSERT_EQ(smooth.samples().size(), 97U) << "every 50 ms over 4.8 s";
+  for (const auto& o : obs) {
+    EXPECT_NEAR(smooth.pose_at(o.t_s).x_m, o.pose.x_m, 1e-9) << "t=" << o.t_s;
+    EXPECT_NEAR(smooth.pose_at(o.t_s).y_m, o.pose.y_m, 1e-9) << "t=" << o.t_s;
+  }
+  // On the straight legs the speed is the recorded one exactly; heading east, then north.
+  EXPECT_NEAR(smooth.velocity_at(0.5).x_m, 1.2, 1e-9);
+  EXPECT_NEAR(smooth.velocity_at(0.5).y_m, 0.0, 1e-9);
+  EXPECT_NEAR(smooth.pose_at(1.0).theta_rad, 0.0, 1e-9);
+  EXPECT_NEAR(smooth.pose_at(4.0).theta_rad, std::numbers::pi / 2, 1e-9);
+  // Linear interpolation turns at once: the whole corner (90 deg, 1.7 m/s) in one 50 ms step.
+  // The smooth track spreads it over the frames either side (it must still pass the corner's
+  // observation: ~0.4 s for the turn, no step more than a third of it).
+  const Jumps linear = largest_jumps(raw, 0.05);
+  const Jumps smoothed = largest_jumps(smooth, 0.05);
+  EXPECT_GT(linear.heading_rad, 1.5);
+  EXPECT_GT(linear.velocity_mps, 1.6);
+  EXPECT_LT(smoothed.heading_rad, linear.heading_rad / 3);
+  EXPECT_LT(smoothed.velocity_mps, linear.velocity_mps / 4);
+}
+
+TEST(SmoothTrack, APersonWhoStopsStaysWhereSeenAndKeepsFacingTheirWay) {
+  // Walking east at 1.2 m/s, then standing with the positions jittering by 2 cm. A smooth curve
+  // that overshoots the stop would step back past it at a walking pace and turn the heading
+  // round; this one does neither.
+  std::vector<sim::TimedPose> obs;
+  for (int i = 0; i <= 8; ++i)
+    obs.push_back({0.4 * i, {0.48 * i, 0.0, 0.0}});
+  for (int i = 9; i < 20; ++i)
+    obs.push_back({0.4 * i, {3.84 + (i % 2 == 0 ? 0.02 : -0.02), (i % 3) * 0.02, 0.0}});
+  const sim::Trajectory smooth = sim::smooth_track(sim::Trajectory(obs));
+  for (const auto& s : smooth.samples()) {
+    EXPECT_LE(s.pose.x_m, 3.87) << "t=" << s.t_s;
+    EXPECT_NEAR(s.pose.theta_rad, 0.0, 1e-9) << "t=" << s.t_s;
+  }
+}
+
+TEST(SmoothTrack, UnderTwoObservationsOrTimesThatDoNotRiseAreHandled) {
+  const sim::Trajectory one(std::vector<sim::TimedPose>{{1.0, {2.0, 3.0, 0.5}}});
+  EXPECT_EQ(sim::smooth_track(one).samples().size(), 1U);
+  // A repeated time keeps the first observation.
+  const sim::Trajectory repeated(std::vector<sim::TimedPose>{{0.0, {0.0, 0.0, 0.0}},
+                                                             {0.4, {0.4, 0.0, 0.0}},
+                                                             {0.4, {9.0, 9.0, 0.0}},
+                                                             {0.8, {0.8, 0.0, 0.0}}});
+  const sim::Trajectory s = sim::smooth_track(repeated);
+  EXPECT_NEAR(s.end_s(), 0.8, 1e-12);
+  for (const auto& p : s.samples())
+    EXPECT_NEAR(p.pose.y_m, 0.0, 1e-12) << "t=" << p.t_s;
+}
+
 // ---- recorded pedestrian datasets ---------------------------------------------------------------
 
 TEST(PedestrianDataset, ParsesFramesIntoSecondsByTheGivenPeriod) {
@@ -329,6 +414,16 @@ TEST(PedestrianDataset, LoadsTheShippedRecordings) {
     ASSERT_TRUE(s) << error;
     EXPECT_GT(s->replayed.size(), 3U) << f;
     EXPECT_GT(s->duration_s, 10.0);
+    // Walked smoothly between the frames: sampled every 50 ms, through every observation.
+    const auto& person = s->person.samples();
+    ASSERT_GT(person.size(), 2U);
+    EXPECT_NEAR(person[1].t_s - person[0].t_s, 0.05, 1e-9) << f;
+    const auto& observed = r.data.people.at(sim::longest_walk(r.data)).samples();
+    const double shift = person.front().t_s - observed.front().t_s;
+    for (const auto& o : observed) {
+      EXPECT_NEAR(s->person.pose_at(o.t_s + shift).x_m, o.pose.x_m, 1e-6) << f << " t=" << o.t_s;
+      EXPECT_NEAR(s->person.pose_at(o.t_s + shift).y_m, o.pose.y_m, 1e-6) << f << " t=" << o.t_s;
+    }
   }
 }
 
@@ -580,6 +675,37 @@ TEST(SimWorld, ThePersonDoesNotWalkIntoAStandingRobotButPastItAndBackOntoTheirPa
   EXPECT_NEAR(end.x_m, 5.0, 0.02) << "back on the script's end point";
   EXPECT_NEAR(end.y_m, 0.0, 0.02);
   EXPECT_EQ(min_clearance(false, &end), 0.0) << "the scripted walk alone goes through the robot";
+}
+
+TEST(SimWorld, ARecordedPedestrianDoesNotWalkIntoAStandingRobotEither) {
+  // A recorded pedestrian whose recording goes straight through where the robot stands (no
+  // commands: the base stays put); the followed person is far away. They walk round it, as a
+  // person does, and back onto their recording; only with replayed_avoid_robot off (the old
+  // replay) do they walk through it.
+  sim::Scenario s;
+  s.name = "t";
+  s.person = sim::walk({{{0.0, 10.0}}, {{5.0, 10.0}, 1.0}}, 0.0);
+  s.replayed.push_back(sim::walk({{{0.0, 0.0}}, {{5.0, 0.0}, 1.0, 4.0}}, 0.0));
+  s.robot_start = Pose2{2.0, 0.0, 0.0};
+  auto min_clearance = [&](bool avoid, Point2* end) {
+    hal::SimClock clock;
+    sim::SimWorldConfig cfg;
+    cfg.replayed_avoid_robot = avoid;
+    sim::SimWorld world(s, cfg, clock);
+    double least = 1e9;
+    for (int ms = 0; ms <= 8500; ms += 5) {  // the recording ends at 9 s
+      world.step(std::chrono::milliseconds(ms));
+      least = std::min(least, world.footprint_clearance_people());
+    }
+    const auto peds = world.pedestrian_positions();
+    *end = peds.empty() ? Point2{-1, -1} : peds.front();
+    return least;
+  };
+  Point2 end;
+  EXPECT_GT(min_clearance(true, &end), 0.04) << "kept the contact margin (0.05 m)";
+  EXPECT_NEAR(end.x_m, 5.0, 0.02) << "back on the recording's end point";
+  EXPECT_NEAR(end.y_m, 0.0, 0.02);
+  EXPECT_EQ(min_clearance(false, &end), 0.0) << "the recording alone goes through the robot";
 }
 
 // ---- the in-process datagram link ---------------------------------------------------------------

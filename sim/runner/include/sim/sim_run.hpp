@@ -32,9 +32,10 @@ struct SimRunOptions {
   double duration_s = 0;  // 0: the scenario's
   // Called every world step (5 ms) before the world advances: fault injection, observation.
   std::function<void(double t_s, SimWorld& world, firmware::Daemon& daemon)> script;
-  bool capture_can = false;         // keep every CAN frame the daemon sends
-  bool quiet = true;                // daemon logs at warning level and above only
-  bool person_avoids_robot = true;  // SimWorldConfig::person_avoids_robot
+  bool capture_can = false;          // keep every CAN frame the daemon sends
+  bool quiet = true;                 // daemon logs at warning level and above only
+  bool person_avoids_robot = true;   // SimWorldConfig::person_avoids_robot
+  bool replayed_avoid_robot = true;  // SimWorldConfig::replayed_avoid_robot
   // The daemon's costmap at these times (s), written as map_server maps STEM-t<time>.pgm/.yaml
   // with what the daemon knew then (sim/costmap_snapshot.hpp): to see why a trial went wrong.
   std::vector<double> costmap_at_s;

@@ -73,6 +73,7 @@ Scenario random_scenario(uint32_t seed, const RandomScenarioOptions& options);
 
 // Recorded pedestrians: the person `follow_id` of `dataset` is followed (from their first to
 // their last observation), everyone else is replayed around them; the robot starts 1 m behind.
+// Everyone walks smoothly between their observations (smooth_track), as the recorded people did.
 struct PedestrianDataset;
 std::optional<Scenario> recorded_scenario(const PedestrianDataset& dataset, int follow_id,
                                           std::string* error);

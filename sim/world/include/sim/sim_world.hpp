@@ -6,6 +6,7 @@
 // bytes as on the robot. Time is passed in (step), so it runs on the simulated clock (fast,
 // deterministic) or on the real one (a thread calling step at its own rate).
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "amfitrack/packet_link.hpp"
@@ -36,6 +37,10 @@ struct SimWorldConfig {
   // past it), and once clear they drift back onto their path at person_return_mps. A contact the
   // robot causes by driving into the person still counts. Off: the person walks through it.
   bool person_avoids_robot = true;
+  // Recorded pedestrians (Scenario::replayed) likewise walk their recording but not into the
+  // robot (evaluation.md: pedestrians react to the robot), with the same margin and return
+  // speed. Off: they walk through it (the recorded tables up to the thirty-seventh session).
+  bool replayed_avoid_robot = true;
   double person_contact_margin_m = 0.05;
   double person_return_mps = 0.5;
 };
@@ -89,8 +94,20 @@ class SimWorld {
   void set_lidar_silent(bool silent) { lidar_silent_ = silent; }
 
  private:
+  // A walker on a scripted path (the person, a recorded pedestrian).
+  struct ScriptedWalker {
+    Point2 at;
+    Point2 offset;  // where they are, minus where their script has them
+    Point2 velocity;
+  };
   void advance(double t_s);
   void move_person(double t_s, double dt_s);
+  void move_replayed(double t_s, double dt_s);
+  // One step of `w` toward `scripted` that does not walk into the robot (SimWorldConfig::
+  // person_avoids_robot); `scripted` carries the way they face.
+  [[nodiscard]] ScriptedWalker step_clear_of_robot(const ScriptedWalker& w,
+                                                   const core::Pose2& scripted, double radius_m,
+                                                   double dt_s) const;
   void update_tracker_pose();
   [[nodiscard]] double footprint_distance(const Point2& p) const;  // point to footprint (world)
   [[nodiscard]] core::Pose2 robot_at(hal::Nanos t) const;
@@ -119,7 +136,9 @@ class SimWorld {
   hal::Nanos prev_robot_time_{0};
   core::Pose2 person_;
   Point2 person_velocity_;
-  Point2 person_offset_;             // where the person is, minus where their script has them
+  Point2 person_offset_;  // where the person is, minus where their script has them
+  // Scenario::replayed's walkers, one each; none while outside their recording's times.
+  std::vector<std::optional<ScriptedWalker>> replayed_;
   std::vector<Cylinder> cylinders_;  // scratch
   std::vector<MovingBody> bodies_;   // scratch
 };

@@ -59,6 +59,15 @@ struct CornerLimits {
 Trajectory walk(const std::vector<Waypoint>& waypoints, double start_s = 0.0, double step_s = 0.05,
                 const CornerLimits& corner = {});
 
+// Recorded positions (a few per second) as the person walked between them: a curve through
+// every observation whose velocity changes smoothly (cubic Hermite pieces, the velocity at each
+// observation from its neighbours), sampled every `step_s` from the first observation to the
+// last, headings from its motion (set_headings_from_motion). Linear interpolation of a 2.5 Hz
+// track makes the walker's velocity and heading jump at every frame (0.4 s), which no walker
+// does and which the daemon would chase. A person who stops has no velocity where they stop,
+// so the curve does not carry them past it and back. Under two observations: as given.
+Trajectory smooth_track(const Trajectory& observed, double step_s = 0.05);
+
 // Path length walked (m).
 double path_length(const Trajectory& t);
 // Headings of position samples from their motion (kept while standing: below 0.2 m/s).
