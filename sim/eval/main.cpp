@@ -171,6 +171,11 @@ int run(int argc, char** argv) {
   app.add_option("--frame-period", frame_period, "seconds between consecutive frame values")
       ->check(CLI::PositiveNumber);
   app.add_option("--follow", follow, "recorded person to accompany (default: who walks farthest)");
+  int walkers = 1;
+  app.add_option("--walkers", walkers,
+                 "with --pedestrians: accompany each of the N people who walk farthest, one "
+                 "trial each (trial i the i-th farthest, seed + i)")
+      ->check(CLI::Range(1, 10000));
   app.add_option("--duration-s", duration_s, "cut every trial to this long (0: the scenario's)")
       ->check(CLI::NonNegativeNumber);
   app.add_flag("--samples", samples, "also write each trial's samples (100 ms) for the plots");
@@ -228,21 +233,35 @@ int run(int argc, char** argv) {
     methods.push_back(*m);
   }
   std::vector<eval::Case> cases;
-  std::optional<sim::Scenario> recorded;
+  std::vector<sim::Scenario> recorded;  // one per trial of the recorded case
   if (!pedestrians.empty()) {
     const auto ds = sim::load_pedestrian_dataset(pedestrians, frame_period);
     if (!ds.ok) {
       std::cerr << ds.error << "\n";
       return 2;
     }
-    std::string error;
-    recorded =
-        sim::recorded_scenario(ds.data, follow >= 0 ? follow : sim::longest_walk(ds.data), &error);
-    if (!recorded) {
-      std::cerr << pedestrians << ": " << error << "\n";
+    if (follow >= 0 && walkers > 1) {
+      std::cerr << "--follow names one person; --walkers picks the N who walk farthest\n";
       return 2;
     }
-    cases.push_back(eval::Case{"recorded", "recorded", 1, {}, 0, 0});
+    const std::vector<int> ids =
+        follow >= 0 ? std::vector<int>{follow} : sim::longest_walks(ds.data, walkers);
+    if (ids.size() < static_cast<size_t>(walkers)) {
+      std::cerr << pedestrians << ": " << ids.size() << " people, " << walkers
+                << " asked for (--walkers)\n";
+      return 2;
+    }
+    for (const int id : ids) {
+      std::string error;
+      auto s = sim::recorded_scenario(ds.data, id, &error);
+      if (!s) {
+        std::cerr << pedestrians << ": " << error << "\n";
+        return 2;
+      }
+      recorded.push_back(std::move(*s));
+    }
+    cases.push_back(
+        eval::Case{"recorded", "recorded", static_cast<int>(recorded.size()), {}, 0, 0});
   } else {
     for (const auto& name : case_names) {
       std::string error;
@@ -279,7 +298,7 @@ int run(int argc, char** argv) {
       sim::SimRunOptions o;
       o.quiet = !daemon_log;
       o.config = eval::trial_config(*loaded.config, *t.c, *t.method);
-      o.scenario = recorded ? *recorded : eval::make_world(*t.c, t.seed);
+      o.scenario = recorded.empty() ? eval::make_world(*t.c, t.seed) : recorded.at(t.index);
       o.seed = t.seed;
       o.duration_s = duration_s;
       o.person_avoids_robot = !person_walks_through;
@@ -329,8 +348,10 @@ int run(int argc, char** argv) {
 
   std::ofstream csv(out_dir + "/trials.csv");
   csv << csv_header();
-  for (const Outcome& o : outcomes)
-    csv << csv_row(o, recorded ? recorded->name : eval::make_world(*o.trial.c, o.trial.seed).name);
+  for (const Outcome& o : outcomes) {
+    csv << csv_row(o, recorded.empty() ? eval::make_world(*o.trial.c, o.trial.seed).name
+                                       : recorded.at(o.trial.index).name);
+  }
 
   // The tables: one per case, the paper's columns, one row per method.
   std::string md = fmt::format(

@@ -5,12 +5,13 @@
 # it, and dead-end corridors) and both recorded-pedestrian files, for every method; then the plots
 # and one report (OUT/REPORT.md: every table, the wall time, trials per minute).
 #
-#   sim/eval/run_benchmark.sh [OUT]          (default: eval-full; ~2 h 15 min on 2 cores)
+#   sim/eval/run_benchmark.sh [OUT]          (default: eval-full; ~2 h 20 min on 2 cores)
 #
 # Environment: EVAL (the companion-eval binary, default build/release/sim/companion-eval),
 # TRIALS (random trials of scenario 7, default 50), VARIANT_TRIALS (per crowd/speed/size/clutter/dead-end case,
 # default 10), METHODS (default objective,fixed_behind,fixed_side,pid; add policy with a policy
 # file in CONFIG), CONFIG (a daemon configuration for every trial, default: built-in defaults),
+# WALKERS (recorded files: accompany each of the N people who walk farthest, default 10),
 # DURATION_S (cut every trial to this long: CI's reduced run), JOBS (trials in parallel), STEPS
 # (default "paper variants recorded"; variants = "crowds speeds sizes constrained": run a subset,
 # e.g. one per sitting of a run longer than a working session; the report takes every step's
@@ -21,6 +22,7 @@ out=${1:-eval-full}
 eval_bin=${EVAL:-build/release/sim/companion-eval}
 trials=${TRIALS:-50}
 variant_trials=${VARIANT_TRIALS:-10}
+walkers=${WALKERS:-10}
 methods=${METHODS:-objective,fixed_behind,fixed_side,pid}
 extra=()
 if [[ -n "${CONFIG:-}" ]]; then extra+=(-c "$CONFIG"); fi
@@ -53,7 +55,8 @@ for step in $steps; do
     crowds | speeds | sizes | constrained) run "$step" --case "$step" --trials "$variant_trials" ;;
     recorded)
       for f in biwi_hotel crowds_zara01; do
-        run "recorded-$f" --pedestrians "sim/data/pedestrians/$f.txt" --frame-period 0.4 --samples
+        run "recorded-$f" --pedestrians "sim/data/pedestrians/$f.txt" --frame-period 0.4 \
+          --walkers "$walkers" --samples
       done
       ;;
   esac
@@ -72,7 +75,7 @@ read -r total seconds < <(cat "${summaries[@]}" /dev/null | awk '/ trials in [0-
 {
   echo "# companion-eval: the full benchmark"
   echo
-  echo "Command: \`sim/eval/run_benchmark.sh $out\` (TRIALS=$trials, VARIANT_TRIALS=$variant_trials,"
+  echo "Command: \`sim/eval/run_benchmark.sh $out\` (TRIALS=$trials, VARIANT_TRIALS=$variant_trials, WALKERS=$walkers,"
   echo "METHODS=$methods${CONFIG:+, CONFIG=$CONFIG}${DURATION_S:+, DURATION_S=$DURATION_S}${STEPS:+; the last sitting STEPS=$STEPS, the report gathers every step found in OUT}), $(date -u +%Y-%m-%d)," \
     "commit $(git rev-parse --short HEAD 2>/dev/null || echo '?')."
   echo

@@ -106,8 +106,8 @@ TEST(CompanionEval, TheOneCommandBenchmarkWritesEveryTableAndPlot) {
   // sim/eval/run_benchmark.sh, reduced: 1 trial per random case, one method, 2 s trials.
   const std::string out = ::testing::TempDir() + "companion-benchmark-ci";
   ChildProcess p({"/usr/bin/env", "EVAL=" COMPANION_EVAL_PATH, "TRIALS=1", "VARIANT_TRIALS=1",
-                  "METHODS=objective", "DURATION_S=2", "JOBS=2", "bash", COMPANION_BENCHMARK_SCRIPT,
-                  out});
+                  "WALKERS=2", "METHODS=objective", "DURATION_S=2", "JOBS=2", "bash",
+                  COMPANION_BENCHMARK_SCRIPT, out});
   ASSERT_TRUE(p.started());
   ASSERT_EQ(p.wait(900s), 0) << p.output();
   const std::string report = slurp(out + "/REPORT.md");
@@ -121,8 +121,9 @@ TEST(CompanionEval, TheOneCommandBenchmarkWritesEveryTableAndPlot) {
         "# recorded-crowds_zara01", "| failures |"}) {
     EXPECT_NE(report.find(expected), std::string::npos) << expected << "\n" << report;
   }
-  // 7 paper cases + 14 variants (the dead end among them) + 2 recorded.
-  EXPECT_NE(report.find("23 trials in"), std::string::npos) << report;
+  // 7 paper cases + 14 variants (the dead end among them) + 2 walkers in each recorded file.
+  EXPECT_NE(report.find("25 trials in"), std::string::npos) << report;
+  EXPECT_NE(report.find("## recorded (2 trials per method)"), std::string::npos) << report;
   for (const char* f : {"/paper/plots/sides-random.png", "/paper/plots/trajectories-doorway.png",
                         "/crowds/plots/sr-crowds.png", "/speeds/plots/sr-speeds.png",
                         "/sizes/plots/sr-sizes.png", "/constrained/plots/sr-constrained.png",
@@ -164,6 +165,21 @@ TEST(CompanionEval, FollowsARecordedPersonFromAnyDatasetFile) {
   const std::string csv = slurp(out + "/trials.csv");
   EXPECT_EQ(lines(csv), 2U);
   EXPECT_NE(csv.find("recorded,objective,1,recorded-203,"), std::string::npos) << csv;
+
+  // --walkers: the three who walk farthest in biwi_hotel (14.0, 13.9, 13.8 m), one trial each.
+  const std::string out3 = ::testing::TempDir() + "companion-eval-recorded-3";
+  ChildProcess q({COMPANION_EVAL_PATH, "--pedestrians", COMPANION_PEDESTRIANS "/biwi_hotel.txt",
+                  "--frame-period", "0.4", "--walkers", "3", "--method", "objective",
+                  "--duration-s", "2", "--out", out3});
+  ASSERT_TRUE(q.started());
+  ASSERT_EQ(q.wait(300s), 0) << q.output();
+  const std::string csv3 = slurp(out3 + "/trials.csv");
+  EXPECT_EQ(lines(csv3), 4U) << csv3;
+  for (const char* row :
+       {"recorded,objective,1,recorded-203,", "recorded,objective,2,recorded-304,",
+        "recorded,objective,3,recorded-366,"}) {
+    EXPECT_NE(csv3.find(row), std::string::npos) << row << "\n" << csv3;
+  }
 }
 
 TEST(CompanionEval, RefusesUnknownCasesMethodsAndPersons) {
@@ -184,4 +200,14 @@ TEST(CompanionEval, RefusesUnknownCasesMethodsAndPersons) {
   ASSERT_TRUE(d.started());
   EXPECT_EQ(d.wait(30s), 2);
   EXPECT_NE(d.output().find("no person with id 99999"), std::string::npos) << d.output();
+  ChildProcess e({COMPANION_EVAL_PATH, "--pedestrians", COMPANION_PEDESTRIANS "/biwi_hotel.txt",
+                  "--follow", "203", "--walkers", "2"});
+  ASSERT_TRUE(e.started());
+  EXPECT_EQ(e.wait(30s), 2);
+  EXPECT_NE(e.output().find("--follow names one person"), std::string::npos) << e.output();
+  ChildProcess f({COMPANION_EVAL_PATH, "--pedestrians", COMPANION_PEDESTRIANS "/biwi_hotel.txt",
+                  "--walkers", "9999"});
+  ASSERT_TRUE(f.started());
+  EXPECT_EQ(f.wait(30s), 2);
+  EXPECT_NE(f.output().find("9999 asked for"), std::string::npos) << f.output();
 }

@@ -110,16 +110,20 @@ DatasetLoad parse_pedestrian_dataset(const std::string& text, double frame_perio
 }
 
 int longest_walk(const PedestrianDataset& dataset) {
-  int best_id = -1;
-  double best = -1;
-  for (const auto& [id, tr] : dataset.people) {
-    const double len = path_length(tr);
-    if (len > best) {
-      best = len;
-      best_id = id;
-    }
-  }
-  return best_id;
+  const std::vector<int> ids = longest_walks(dataset, 1);
+  return ids.empty() ? -1 : ids.front();
+}
+
+std::vector<int> longest_walks(const PedestrianDataset& dataset, size_t n) {
+  std::vector<std::pair<double, int>> walks;  // (path length, id), in id order
+  for (const auto& [id, tr] : dataset.people)
+    walks.emplace_back(path_length(tr), id);
+  std::stable_sort(walks.begin(), walks.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::vector<int> ids;
+  for (size_t i = 0; i < std::min(n, walks.size()); ++i)
+    ids.push_back(walks[i].second);
+  return ids;
 }
 
 DatasetLoad load_pedestrian_dataset(const std::string& path, double frame_period_s) {

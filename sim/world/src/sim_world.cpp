@@ -142,12 +142,42 @@ void SimWorld::move_replayed(double t_s, double dt_s) {
       continue;
     }
     const core::Pose2 scripted = r.pose_at(t_s);
-    if (!w || !config_.replayed_avoid_robot || dt_s <= 0) {
+    const bool appears = !w.has_value();
+    if (appears || !config_.replayed_avoid_robot || dt_s <= 0) {
       w = ScriptedWalker{{scripted.x_m, scripted.y_m}, {}, r.velocity_at(t_s)};
+      if (appears && config_.replayed_avoid_robot) w->at = clear_of_robot(w->at, kReplayedRadiusM);
+      w->offset = {w->at.x_m - scripted.x_m, w->at.y_m - scripted.y_m};
       continue;
     }
     w = step_clear_of_robot(*w, scripted, kReplayedRadiusM, dt_s);
   }
+}
+
+Point2 SimWorld::footprint_normal(const Point2& p) const {
+  const core::Pose2 robot = robot_pose();
+  const Point2 q = robot.inverse().apply(p);
+  const Point2 c{std::clamp(q.x_m, config_.footprint_x_min_m, config_.footprint_x_max_m),
+                 std::clamp(q.y_m, config_.footprint_y_min_m, config_.footprint_y_max_m)};
+  double nx = q.x_m - c.x_m, ny = q.y_m - c.y_m;
+  double n_len = std::hypot(nx, ny);
+  if (n_len < 1e-9) {  // inside (the robot drove into them): away from its centre
+    nx = q.x_m;
+    ny = q.y_m;
+    n_len = std::max(std::hypot(nx, ny), 1e-9);
+  }
+  return robot.rotate({nx / n_len, ny / n_len});
+}
+
+Point2 SimWorld::clear_of_robot(Point2 p, double radius_m) const {
+  // In centimetre steps along the normal: it runs only when someone appears at the robot.
+  constexpr double kStepM = 0.01;
+  constexpr int kMaxSteps = 300;
+  const Point2 n = footprint_normal(p);
+  for (int i = 0;
+       i < kMaxSteps && footprint_distance(p) - radius_m < config_.person_contact_margin_m; ++i) {
+    p = {p.x_m + kStepM * n.x_m, p.y_m + kStepM * n.y_m};
+  }
+  return p;
 }
 
 SimWorld::ScriptedWalker SimWorld::step_clear_of_robot(const ScriptedWalker& w,
@@ -166,19 +196,8 @@ SimWorld::ScriptedWalker SimWorld::step_clear_of_robot(const ScriptedWalker& w,
   const double gap_from = footprint_distance(from) - radius_m;
   const double gap_to = footprint_distance(to) - radius_m;
   if (gap_to < margin && gap_to < gap_from) {
-    // The outward normal of the footprint at the walker (base_link's box, then the world).
     const core::Pose2 robot = robot_pose();
-    const Point2 q = robot.inverse().apply(from);
-    const Point2 c{std::clamp(q.x_m, config_.footprint_x_min_m, config_.footprint_x_max_m),
-                   std::clamp(q.y_m, config_.footprint_y_min_m, config_.footprint_y_max_m)};
-    double nx = q.x_m - c.x_m, ny = q.y_m - c.y_m;
-    double n_len = std::hypot(nx, ny);
-    if (n_len < 1e-9) {  // inside (the robot drove into them): away from its centre
-      nx = q.x_m;
-      ny = q.y_m;
-      n_len = std::max(std::hypot(nx, ny), 1e-9);
-    }
-    const Point2 n = robot.rotate({nx / n_len, ny / n_len});
+    const Point2 n = footprint_normal(from);
     Point2 step{to.x_m - from.x_m, to.y_m - from.y_m};
     const double into = step.x_m * n.x_m + step.y_m * n.y_m;
     if (into < 0) {

@@ -376,6 +376,8 @@ TEST(PedestrianDataset, ParsesFramesIntoSecondsByTheGivenPeriod) {
   EXPECT_NEAR(p2.end_s(), 0.8, 1e-12) << "a gap of one frame is bridged";
   EXPECT_NEAR(p2.pose_at(0.4).y_m, 5.2, 1e-9);
   EXPECT_EQ(sim::longest_walk(r.data), 1);
+  EXPECT_EQ(sim::longest_walks(r.data, 5), (std::vector<int>{1, 2})) << "farthest first";
+  EXPECT_EQ(sim::longest_walks(r.data, 1), (std::vector<int>{1}));
 }
 
 TEST(PedestrianDataset, BadInputIsAClearErrorWithTheLine) {
@@ -706,6 +708,35 @@ TEST(SimWorld, ARecordedPedestrianDoesNotWalkIntoAStandingRobotEither) {
   EXPECT_NEAR(end.x_m, 5.0, 0.02) << "back on the recording's end point";
   EXPECT_NEAR(end.y_m, 0.0, 0.02);
   EXPECT_EQ(min_clearance(false, &end), 0.0) << "the recording alone goes through the robot";
+}
+
+TEST(SimWorld, ARecordedPedestrianFirstSeenWhereTheRobotStandsAppearsClearOfIt) {
+  // The recording starts at 1 s inside the standing robot's footprint (a person entering the
+  // camera's view there). They appear just clear of it and walk back onto their recording.
+  sim::Scenario s;
+  s.name = "t";
+  s.person = sim::walk({{{0.0, 10.0}}, {{5.0, 10.0}, 1.0}}, 0.0);
+  s.replayed.push_back(sim::walk({{{2.1, 0.1}}, {{2.1, 4.0}, 1.0, 2.0}}, 1.0));
+  s.robot_start = Pose2{2.0, 0.0, 0.0};
+  auto min_clearance = [&](bool avoid, Point2* end) {
+    hal::SimClock clock;
+    sim::SimWorldConfig cfg;
+    cfg.replayed_avoid_robot = avoid;
+    sim::SimWorld world(s, cfg, clock);
+    double least = 1e9;
+    for (int ms = 0; ms <= 6000; ms += 5) {  // the recording ends at 6.9 s
+      world.step(std::chrono::milliseconds(ms));
+      least = std::min(least, world.footprint_clearance_people());
+    }
+    const auto peds = world.pedestrian_positions();
+    *end = peds.empty() ? Point2{-1, -1} : peds.front();
+    return least;
+  };
+  Point2 end;
+  EXPECT_GT(min_clearance(true, &end), 0.04) << "appeared keeping the contact margin (0.05 m)";
+  EXPECT_NEAR(end.x_m, 2.1, 0.02) << "back on the recording";
+  EXPECT_NEAR(end.y_m, 4.0, 0.02);
+  EXPECT_EQ(min_clearance(false, &end), 0.0) << "the recording alone starts inside the robot";
 }
 
 // ---- the in-process datagram link ---------------------------------------------------------------

@@ -30,5 +30,8 @@ DatasetLoad load_pedestrian_dataset(const std::string& path, double frame_period
 
 // The id of the person who walks the farthest (a good default to follow); -1 when empty.
 int longest_walk(const PedestrianDataset& dataset);
+// The ids of the `n` people who walk the farthest, the farthest first (equal walks: the lower
+// id first); fewer when the file has fewer people.
+std::vector<int> longest_walks(const PedestrianDataset& dataset, size_t n);
 
 }  // namespace sim

@@ -39,7 +39,8 @@ struct SimWorldConfig {
   bool person_avoids_robot = true;
   // Recorded pedestrians (Scenario::replayed) likewise walk their recording but not into the
   // robot (evaluation.md: pedestrians react to the robot), with the same margin and return
-  // speed. Off: they walk through it (the recorded tables up to the thirty-seventh session).
+  // speed; one first seen where the robot stands appears just clear of it. Off: they walk
+  // through it and appear where recorded (the recorded tables up to the thirty-seventh session).
   bool replayed_avoid_robot = true;
   double person_contact_margin_m = 0.05;
   double person_return_mps = 0.5;
@@ -108,6 +109,12 @@ class SimWorld {
   [[nodiscard]] ScriptedWalker step_clear_of_robot(const ScriptedWalker& w,
                                                    const core::Pose2& scripted, double radius_m,
                                                    double dt_s) const;
+  // The footprint's outward normal at `p` (world frame; from its centre when inside it).
+  [[nodiscard]] Point2 footprint_normal(const Point2& p) const;
+  // `p` moved out along that normal until a body of `radius_m` there keeps the contact margin:
+  // where a recorded pedestrian first seen at the robot is (they walked round it unseen, and
+  // return to their recording as from any detour).
+  [[nodiscard]] Point2 clear_of_robot(Point2 p, double radius_m) const;
   void update_tracker_pose();
   [[nodiscard]] double footprint_distance(const Point2& p) const;  // point to footprint (world)
   [[nodiscard]] core::Pose2 robot_at(hal::Nanos t) const;
