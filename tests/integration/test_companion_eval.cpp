@@ -182,32 +182,25 @@ TEST(CompanionEval, FollowsARecordedPersonFromAnyDatasetFile) {
   }
 }
 
+namespace {
+// companion-eval with `args` exits 2 and names the problem.
+void expect_refused(const std::vector<std::string>& args, const std::string& message) {
+  std::vector<std::string> argv{COMPANION_EVAL_PATH};
+  argv.insert(argv.end(), args.begin(), args.end());
+  ChildProcess p(argv);
+  ASSERT_TRUE(p.started());
+  EXPECT_EQ(p.wait(30s), 2) << p.output();
+  EXPECT_NE(p.output().find(message), std::string::npos) << message << "\n" << p.output();
+}
+}  // namespace
+
 TEST(CompanionEval, RefusesUnknownCasesMethodsAndPersons) {
-  ChildProcess a({COMPANION_EVAL_PATH, "--case", "moon"});
-  ASSERT_TRUE(a.started());
-  EXPECT_EQ(a.wait(30s), 2);
-  EXPECT_NE(a.output().find("unknown case 'moon'"), std::string::npos) << a.output();
-  ChildProcess b({COMPANION_EVAL_PATH, "--method", "teleport"});
-  ASSERT_TRUE(b.started());
-  EXPECT_EQ(b.wait(30s), 2);
-  EXPECT_NE(b.output().find("unknown method 'teleport'"), std::string::npos) << b.output();
-  ChildProcess c({COMPANION_EVAL_PATH, "--method", "policy"});
-  ASSERT_TRUE(c.started());
-  EXPECT_EQ(c.wait(30s), 2);
-  EXPECT_NE(c.output().find("needs a policy file"), std::string::npos) << c.output();
-  ChildProcess d({COMPANION_EVAL_PATH, "--pedestrians", COMPANION_PEDESTRIANS "/biwi_hotel.txt",
-                  "--follow", "99999"});
-  ASSERT_TRUE(d.started());
-  EXPECT_EQ(d.wait(30s), 2);
-  EXPECT_NE(d.output().find("no person with id 99999"), std::string::npos) << d.output();
-  ChildProcess e({COMPANION_EVAL_PATH, "--pedestrians", COMPANION_PEDESTRIANS "/biwi_hotel.txt",
-                  "--follow", "203", "--walkers", "2"});
-  ASSERT_TRUE(e.started());
-  EXPECT_EQ(e.wait(30s), 2);
-  EXPECT_NE(e.output().find("--follow names one person"), std::string::npos) << e.output();
-  ChildProcess f({COMPANION_EVAL_PATH, "--pedestrians", COMPANION_PEDESTRIANS "/biwi_hotel.txt",
-                  "--walkers", "9999"});
-  ASSERT_TRUE(f.started());
-  EXPECT_EQ(f.wait(30s), 2);
-  EXPECT_NE(f.output().find("9999 asked for"), std::string::npos) << f.output();
+  expect_refused({"--case", "moon"}, "unknown case 'moon'");
+  expect_refused({"--method", "teleport"}, "unknown method 'teleport'");
+  expect_refused({"--method", "policy"}, "needs a policy file");
+  const std::string biwi = COMPANION_PEDESTRIANS "/biwi_hotel.txt";
+  expect_refused({"--pedestrians", biwi, "--follow", "99999"}, "no person with id 99999");
+  expect_refused({"--pedestrians", biwi, "--follow", "203", "--walkers", "2"},
+                 "--follow names one person");
+  expect_refused({"--pedestrians", biwi, "--walkers", "9999"}, "9999 asked for");
 }

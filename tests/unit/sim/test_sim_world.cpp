@@ -653,61 +653,63 @@ TEST(SimWorld, TrackerFramesPlaceThePersonWhereTheWorldHasThem) {
   EXPECT_NEAR(frames, 60, 1) << "120 Hz";
 }
 
+namespace {
+// The world run with the robot standing (no commands: the base stays put) until `until_ms`:
+// the least clearance between its footprint and anyone, and where everyone is then.
+struct StandingRobotRun {
+  double least_clearance_m = 1e9;
+  Pose2 person;
+  std::vector<Point2> pedestrians;
+};
+StandingRobotRun run_beside_standing_robot(const sim::Scenario& s, const sim::SimWorldConfig& cfg,
+                                           int until_ms) {
+  hal::SimClock clock;
+  sim::SimWorld world(s, cfg, clock);
+  StandingRobotRun r;
+  for (int ms = 0; ms <= until_ms; ms += 5) {
+    world.step(std::chrono::milliseconds(ms));
+    r.least_clearance_m = std::min(r.least_clearance_m, world.footprint_clearance_people());
+  }
+  r.person = world.person_pose();
+  r.pedestrians = world.pedestrian_positions();
+  return r;
+}
+}  // namespace
+
 TEST(SimWorld, ThePersonDoesNotWalkIntoAStandingRobotButPastItAndBackOntoTheirPath) {
-  // The robot stands on the person's scripted line (no commands: the base stays put).
+  // The robot stands on the person's scripted line.
   sim::Scenario s;
   s.name = "t";
   s.person = sim::walk({{{0.0, 0.0}}, {{5.0, 0.0}, 1.0}}, 0.0);
   s.robot_start = Pose2{2.0, 0.0, 0.0};
-  auto min_clearance = [&](bool avoids, Pose2* end) {
-    hal::SimClock clock;
-    sim::SimWorldConfig cfg;
-    cfg.person_avoids_robot = avoids;
-    sim::SimWorld world(s, cfg, clock);
-    double least = 1e9;
-    for (int ms = 0; ms <= 9000; ms += 5) {
-      world.step(std::chrono::milliseconds(ms));
-      least = std::min(least, world.footprint_clearance_people());
-    }
-    *end = world.person_pose();
-    return least;
-  };
-  Pose2 end;
-  EXPECT_GT(min_clearance(true, &end), 0.04) << "kept the contact margin (0.05 m)";
-  EXPECT_NEAR(end.x_m, 5.0, 0.02) << "back on the script's end point";
-  EXPECT_NEAR(end.y_m, 0.0, 0.02);
-  EXPECT_EQ(min_clearance(false, &end), 0.0) << "the scripted walk alone goes through the robot";
+  sim::SimWorldConfig cfg;
+  const StandingRobotRun avoids = run_beside_standing_robot(s, cfg, 9000);
+  EXPECT_GT(avoids.least_clearance_m, 0.04) << "kept the contact margin (0.05 m)";
+  EXPECT_NEAR(avoids.person.x_m, 5.0, 0.02) << "back on the script's end point";
+  EXPECT_NEAR(avoids.person.y_m, 0.0, 0.02);
+  cfg.person_avoids_robot = false;
+  EXPECT_EQ(run_beside_standing_robot(s, cfg, 9000).least_clearance_m, 0.0)
+      << "the scripted walk alone goes through the robot";
 }
 
 TEST(SimWorld, ARecordedPedestrianDoesNotWalkIntoAStandingRobotEither) {
-  // A recorded pedestrian whose recording goes straight through where the robot stands (no
-  // commands: the base stays put); the followed person is far away. They walk round it, as a
-  // person does, and back onto their recording; only with replayed_avoid_robot off (the old
-  // replay) do they walk through it.
+  // A recorded pedestrian whose recording goes straight through where the robot stands; the
+  // followed person is far away. They walk round it, as a person does, and back onto their
+  // recording; only with replayed_avoid_robot off (the old replay) do they walk through it.
   sim::Scenario s;
   s.name = "t";
   s.person = sim::walk({{{0.0, 10.0}}, {{5.0, 10.0}, 1.0}}, 0.0);
   s.replayed.push_back(sim::walk({{{0.0, 0.0}}, {{5.0, 0.0}, 1.0, 4.0}}, 0.0));
   s.robot_start = Pose2{2.0, 0.0, 0.0};
-  auto min_clearance = [&](bool avoid, Point2* end) {
-    hal::SimClock clock;
-    sim::SimWorldConfig cfg;
-    cfg.replayed_avoid_robot = avoid;
-    sim::SimWorld world(s, cfg, clock);
-    double least = 1e9;
-    for (int ms = 0; ms <= 8500; ms += 5) {  // the recording ends at 9 s
-      world.step(std::chrono::milliseconds(ms));
-      least = std::min(least, world.footprint_clearance_people());
-    }
-    const auto peds = world.pedestrian_positions();
-    *end = peds.empty() ? Point2{-1, -1} : peds.front();
-    return least;
-  };
-  Point2 end;
-  EXPECT_GT(min_clearance(true, &end), 0.04) << "kept the contact margin (0.05 m)";
-  EXPECT_NEAR(end.x_m, 5.0, 0.02) << "back on the recording's end point";
-  EXPECT_NEAR(end.y_m, 0.0, 0.02);
-  EXPECT_EQ(min_clearance(false, &end), 0.0) << "the recording alone goes through the robot";
+  sim::SimWorldConfig cfg;
+  const StandingRobotRun avoid = run_beside_standing_robot(s, cfg, 8500);  // ends at 9 s
+  EXPECT_GT(avoid.least_clearance_m, 0.04) << "kept the contact margin (0.05 m)";
+  ASSERT_EQ(avoid.pedestrians.size(), 1U);
+  EXPECT_NEAR(avoid.pedestrians[0].x_m, 5.0, 0.02) << "back on the recording's end point";
+  EXPECT_NEAR(avoid.pedestrians[0].y_m, 0.0, 0.02);
+  cfg.replayed_avoid_robot = false;
+  EXPECT_EQ(run_beside_standing_robot(s, cfg, 8500).least_clearance_m, 0.0)
+      << "the recording alone goes through the robot";
 }
 
 TEST(SimWorld, ARecordedPedestrianFirstSeenWhereTheRobotStandsAppearsClearOfIt) {
@@ -718,25 +720,15 @@ TEST(SimWorld, ARecordedPedestrianFirstSeenWhereTheRobotStandsAppearsClearOfIt) 
   s.person = sim::walk({{{0.0, 10.0}}, {{5.0, 10.0}, 1.0}}, 0.0);
   s.replayed.push_back(sim::walk({{{2.1, 0.1}}, {{2.1, 4.0}, 1.0, 2.0}}, 1.0));
   s.robot_start = Pose2{2.0, 0.0, 0.0};
-  auto min_clearance = [&](bool avoid, Point2* end) {
-    hal::SimClock clock;
-    sim::SimWorldConfig cfg;
-    cfg.replayed_avoid_robot = avoid;
-    sim::SimWorld world(s, cfg, clock);
-    double least = 1e9;
-    for (int ms = 0; ms <= 6000; ms += 5) {  // the recording ends at 6.9 s
-      world.step(std::chrono::milliseconds(ms));
-      least = std::min(least, world.footprint_clearance_people());
-    }
-    const auto peds = world.pedestrian_positions();
-    *end = peds.empty() ? Point2{-1, -1} : peds.front();
-    return least;
-  };
-  Point2 end;
-  EXPECT_GT(min_clearance(true, &end), 0.04) << "appeared keeping the contact margin (0.05 m)";
-  EXPECT_NEAR(end.x_m, 2.1, 0.02) << "back on the recording";
-  EXPECT_NEAR(end.y_m, 4.0, 0.02);
-  EXPECT_EQ(min_clearance(false, &end), 0.0) << "the recording alone starts inside the robot";
+  sim::SimWorldConfig cfg;
+  const StandingRobotRun avoid = run_beside_standing_robot(s, cfg, 6000);  // ends at 6.9 s
+  EXPECT_GT(avoid.least_clearance_m, 0.04) << "appeared keeping the contact margin (0.05 m)";
+  ASSERT_EQ(avoid.pedestrians.size(), 1U);
+  EXPECT_NEAR(avoid.pedestrians[0].x_m, 2.1, 0.02) << "back on the recording";
+  EXPECT_NEAR(avoid.pedestrians[0].y_m, 4.0, 0.02);
+  cfg.replayed_avoid_robot = false;
+  EXPECT_EQ(run_beside_standing_robot(s, cfg, 6000).least_clearance_m, 0.0)
+      << "the recording alone starts inside the robot";
 }
 
 // ---- the in-process datagram link ---------------------------------------------------------------
