@@ -20,6 +20,12 @@ struct Row {
 
 // A day of recording: frame values spanning more than this are not frame numbers.
 constexpr double kMaxDurationS = 86400.0;
+// Positions in metres: beyond a thousand kilometres they are not a scene's (and the walk's
+// velocities would overflow).
+constexpr double kMaxCoordinateM = 1e6;
+// Seconds between frames: from a 1 kHz tracker to a frame a minute.
+constexpr double kMinFramePeriodS = 1e-3;
+constexpr double kMaxFramePeriodS = 60.0;
 
 bool parse_double(const std::string& token, double& out) {
   errno = 0;
@@ -32,8 +38,9 @@ bool parse_double(const std::string& token, double& out) {
 DatasetLoad parse_pedestrian_dataset(const std::string& text, double frame_period_s,
                                      const std::string& name) {
   DatasetLoad r;
-  if (!(frame_period_s > 0) || !std::isfinite(frame_period_s)) {
-    r.error = fmt::format("{}: frame period must be > 0 s (got {})", name, frame_period_s);
+  if (!(frame_period_s >= kMinFramePeriodS && frame_period_s <= kMaxFramePeriodS)) {
+    r.error = fmt::format("{}: frame period must be {} to {} s (got {})", name, kMinFramePeriodS,
+                          kMaxFramePeriodS, frame_period_s);
     return r;
   }
   std::vector<Row> rows;
@@ -64,6 +71,11 @@ DatasetLoad parse_pedestrian_dataset(const std::string& text, double frame_perio
     if (v[1] != std::floor(v[1]) || std::abs(v[1]) > 1e9) {
       r.error =
           fmt::format("{}:{}: person id must be a whole number, got '{}'", name, line_no, tok[1]);
+      return r;
+    }
+    if (std::abs(v[2]) > kMaxCoordinateM || std::abs(v[3]) > kMaxCoordinateM) {
+      r.error = fmt::format("{}:{}: position ({}, {}) is more than {:.0f} km out: not metres", name,
+                            line_no, tok[2], tok[3], kMaxCoordinateM / 1000);
       return r;
     }
     rows.push_back({v[0], v[2], v[3], static_cast<int>(v[1])});

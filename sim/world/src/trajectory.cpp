@@ -58,6 +58,11 @@ void set_headings_from_motion(std::vector<TimedPose>& samples) {
 
 namespace {
 
+// Observations further apart than this are not joined by a curve (a person unseen for a while):
+// the gap is walked straight, and the observations either side take their velocities from their
+// own side only.
+constexpr double kMaxSmoothGapS = 2.0;
+
 // The walker's velocity at each observation for a cubic Hermite curve through them: the
 // derivative of the parabola through it and its two neighbours (Catmull-Rom's for uneven
 // steps), so a corner is cut as walkers cut it and a straight walk at one speed stays exactly
@@ -79,6 +84,10 @@ std::vector<core::Point2> observation_velocities(const std::vector<TimedPose>& o
   for (size_t k = 1; k + 1 < n; ++k) {
     const double h0 = obs[k].t_s - obs[k - 1].t_s;
     const double h1 = obs[k + 1].t_s - obs[k].t_s;
+    if (h0 > kMaxSmoothGapS || h1 > kMaxSmoothGapS) {  // a track's end beside a gap
+      v[k] = h1 > kMaxSmoothGapS ? (h0 > kMaxSmoothGapS ? core::Point2{} : chord[k - 1]) : chord[k];
+      continue;
+    }
     const double w0 = h1 / (h0 + h1);  // the nearer neighbour's chord counts more
     const double w1 = h0 / (h0 + h1);
     core::Point2 m{w0 * chord[k - 1].x_m + w1 * chord[k].x_m,
@@ -111,24 +120,40 @@ Trajectory smooth_track(const Trajectory& observed, double step_s) {
   if (obs.size() < 2) return observed;
   const std::vector<core::Point2> v = observation_velocities(obs);
   std::vector<TimedPose> out;
-  size_t k = 0;
+  auto emit_observation = [&](size_t k) {
+    if (out.empty() || obs[k].t_s - out.back().t_s > 1e-9) {
+      out.push_back({obs[k].t_s, {obs[k].pose.x_m, obs[k].pose.y_m, 0.0}});
+    }
+  };
+  // On one time grid from the first observation; a gap longer than kMaxSmoothGapS keeps only
+  // its two ends (walked straight, as linear interpolation did), so the samples stay within a
+  // bounded number per observation whatever times a file gives.
   const double t0 = obs.front().t_s;
-  const auto steps = static_cast<size_t>(std::floor((obs.back().t_s - t0) / step_s + 1e-9));
-  for (size_t i = 0; i <= steps; ++i) {
-    const double t = t0 + static_cast<double>(i) * step_s;
-    while (k + 2 < obs.size() && obs[k + 1].t_s <= t)
-      ++k;
+  const auto last_i = static_cast<size_t>(std::floor((obs.back().t_s - t0) / step_s + 1e-9));
+  size_t i = 0;  // grid index, rising through the pieces
+  for (size_t k = 0; k + 1 < obs.size(); ++k) {
     const core::Pose2& a = obs[k].pose;
     const core::Pose2& b = obs[k + 1].pose;
     const double h = obs[k + 1].t_s - obs[k].t_s;
-    const double s = std::clamp((t - obs[k].t_s) / h, 0.0, 1.0);
-    out.push_back({t,
-                   {hermite(a.x_m, b.x_m, v[k].x_m, v[k + 1].x_m, h, s),
-                    hermite(a.y_m, b.y_m, v[k].y_m, v[k + 1].y_m, h, s), 0.0}});
+    if (h > kMaxSmoothGapS) {
+      emit_observation(k);
+      emit_observation(k + 1);
+      while (i <= last_i && t0 + static_cast<double>(i) * step_s < obs[k + 1].t_s)
+        ++i;
+      continue;
+    }
+    const bool last_piece = k + 2 == obs.size();
+    for (; i <= last_i; ++i) {
+      const double t = t0 + static_cast<double>(i) * step_s;
+      if (!last_piece && t >= obs[k + 1].t_s) break;
+      if (!out.empty() && t - out.back().t_s <= 1e-9) continue;  // a gap's end, emitted
+      const double s = std::clamp((t - obs[k].t_s) / h, 0.0, 1.0);
+      out.push_back({t,
+                     {hermite(a.x_m, b.x_m, v[k].x_m, v[k + 1].x_m, h, s),
+                      hermite(a.y_m, b.y_m, v[k].y_m, v[k + 1].y_m, h, s), 0.0}});
+    }
   }
-  if (obs.back().t_s - out.back().t_s > 1e-9) {
-    out.push_back({obs.back().t_s, {obs.back().pose.x_m, obs.back().pose.y_m, 0.0}});
-  }
+  emit_observation(obs.size() - 1);
   set_headings_from_motion(out);
   return Trajectory(std::move(out));
 }

@@ -338,6 +338,21 @@ TEST(SmoothTrack, APersonWhoStopsStaysWhereSeenAndKeepsFacingTheirWay) {
   }
 }
 
+TEST(SmoothTrack, APersonUnseenForLongIsNotFilledInAndCostsNoSamples) {
+  // Seen twice, then again a day later: the day is one straight piece (two samples), not
+  // 1.7 million of them; the frames either side are walked as before.
+  const sim::Trajectory observed(std::vector<sim::TimedPose>{{0.0, {0.0, 0.0, 0.0}},
+                                                             {0.4, {0.4, 0.0, 0.0}},
+                                                             {86400.0, {10.0, 0.0, 0.0}},
+                                                             {86400.4, {10.4, 0.0, 0.0}}});
+  const sim::Trajectory s = sim::smooth_track(observed);
+  EXPECT_LT(s.samples().size(), 30U);
+  EXPECT_NEAR(s.pose_at(0.2).x_m, 0.2, 1e-9);
+  EXPECT_NEAR(s.pose_at(43200.2).x_m, 5.2, 1e-6) << "across the gap: straight";
+  EXPECT_NEAR(s.pose_at(86400.2).x_m, 10.2, 1e-6);
+  EXPECT_NEAR(s.end_s(), 86400.4, 1e-9);
+}
+
 TEST(SmoothTrack, UnderTwoObservationsOrTimesThatDoNotRiseAreHandled) {
   const sim::Trajectory one(std::vector<sim::TimedPose>{{1.0, {2.0, 3.0, 0.5}}});
   EXPECT_EQ(sim::smooth_track(one).samples().size(), 1U);
@@ -397,6 +412,12 @@ TEST(PedestrianDataset, BadInputIsAClearErrorWithTheLine) {
   EXPECT_EQ(r.error, "f.txt: no observations");
   r = sim::parse_pedestrian_dataset("0 1 2 3\n", 0.0, "f.txt");
   EXPECT_FALSE(r.ok);
+  r = sim::parse_pedestrian_dataset("0 1 2 3\n", 1e-300, "f.txt");
+  EXPECT_FALSE(r.ok) << "a frame period that would make every walk infinitely fast";
+  EXPECT_NE(r.error.find("frame period must be"), std::string::npos) << r.error;
+  r = sim::parse_pedestrian_dataset("0 1 2 3\n10 1 1e300 3\n", 0.4, "f.txt");
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.error, "f.txt:2: position (1e300, 3) is more than 1000 km out: not metres");
   r = sim::parse_pedestrian_dataset("0 1 2 3\n1 1 2 3\n1e300 1 2 3\n", 0.4, "f.txt");
   EXPECT_FALSE(r.ok) << "frame values that span centuries";
   EXPECT_NE(r.error.find("not a recording"), std::string::npos) << r.error;
