@@ -75,7 +75,8 @@ read -r total seconds < <(cat "${summaries[@]}" /dev/null | awk '/ trials in [0-
 {
   echo "# companion-eval: the full benchmark"
   echo
-  echo "Command: \`sim/eval/run_benchmark.sh $out\` (TRIALS=$trials, VARIANT_TRIALS=$variant_trials, WALKERS=$walkers,"
+  echo "Command: \`sim/eval/run_benchmark.sh $out\` (TRIALS=$trials, VARIANT_TRIALS=$variant_trials,"
+  echo "WALKERS=$walkers,"
   echo "METHODS=$methods${CONFIG:+, CONFIG=$CONFIG}${DURATION_S:+, DURATION_S=$DURATION_S}${STEPS:+; the last sitting STEPS=$STEPS, the report gathers every step found in OUT}), $(date -u +%Y-%m-%d)," \
     "commit $(git rev-parse --short HEAD 2>/dev/null || echo '?')."
   echo

@@ -17,6 +17,10 @@ using test_support::ChildProcess;
 using test_support::slurp;
 
 namespace {
+// Joined here, not inside the argument lists (where a joined literal reads as a missing comma).
+constexpr const char* kEvalEnv = "EVAL=" COMPANION_EVAL_PATH;
+constexpr const char* kBiwiHotel = COMPANION_PEDESTRIANS "/biwi_hotel.txt";
+
 size_t lines(const std::string& s) {
   size_t n = 0;
   for (char c : s)
@@ -105,9 +109,9 @@ TEST(CompanionEval, RunsCasesAndMethodsByNameAndWritesTablesCsvAndPlots) {
 TEST(CompanionEval, TheOneCommandBenchmarkWritesEveryTableAndPlot) {
   // sim/eval/run_benchmark.sh, reduced: 1 trial per random case, one method, 2 s trials.
   const std::string out = ::testing::TempDir() + "companion-benchmark-ci";
-  ChildProcess p({"/usr/bin/env", "EVAL=" COMPANION_EVAL_PATH, "TRIALS=1", "VARIANT_TRIALS=1",
-                  "WALKERS=2", "METHODS=objective", "DURATION_S=2", "JOBS=2", "bash",
-                  COMPANION_BENCHMARK_SCRIPT, out});
+  ChildProcess p({"/usr/bin/env", kEvalEnv, "TRIALS=1", "VARIANT_TRIALS=1", "WALKERS=2",
+                  "METHODS=objective", "DURATION_S=2", "JOBS=2", "bash", COMPANION_BENCHMARK_SCRIPT,
+                  out});
   ASSERT_TRUE(p.started());
   ASSERT_EQ(p.wait(900s), 0) << p.output();
   const std::string report = slurp(out + "/REPORT.md");
@@ -137,9 +141,8 @@ TEST(CompanionEval, TheBenchmarkCanRunInSittingsIntoOneReport) {
   // OUT, and the report gathers every group found there.
   const std::string out = ::testing::TempDir() + "companion-benchmark-sittings";
   for (const char* steps : {"STEPS=sizes", "STEPS=speeds"}) {
-    ChildProcess p({"/usr/bin/env", "EVAL=" COMPANION_EVAL_PATH, "VARIANT_TRIALS=1",
-                    "METHODS=objective", "DURATION_S=1", "JOBS=2", steps, "bash",
-                    COMPANION_BENCHMARK_SCRIPT, out});
+    ChildProcess p({"/usr/bin/env", kEvalEnv, "VARIANT_TRIALS=1", "METHODS=objective",
+                    "DURATION_S=1", "JOBS=2", steps, "bash", COMPANION_BENCHMARK_SCRIPT, out});
     ASSERT_TRUE(p.started());
     ASSERT_EQ(p.wait(300s), 0) << p.output();
   }
@@ -148,8 +151,8 @@ TEST(CompanionEval, TheBenchmarkCanRunInSittingsIntoOneReport) {
   EXPECT_NE(report.find("\n# speeds\n"), std::string::npos) << report;
   EXPECT_EQ(report.find("\n# crowds\n"), std::string::npos) << report;
   EXPECT_NE(report.find("6 trials in"), std::string::npos) << report;  // 3 sizes + 3 speeds
-  ChildProcess bad({"/usr/bin/env", "EVAL=" COMPANION_EVAL_PATH, "STEPS=moon", "bash",
-                    COMPANION_BENCHMARK_SCRIPT, out});
+  ChildProcess bad(
+      {"/usr/bin/env", kEvalEnv, "STEPS=moon", "bash", COMPANION_BENCHMARK_SCRIPT, out});
   ASSERT_TRUE(bad.started());
   EXPECT_EQ(bad.wait(30s), 2);
   EXPECT_NE(bad.output().find("unknown step 'moon'"), std::string::npos) << bad.output();
@@ -157,9 +160,8 @@ TEST(CompanionEval, TheBenchmarkCanRunInSittingsIntoOneReport) {
 
 TEST(CompanionEval, FollowsARecordedPersonFromAnyDatasetFile) {
   const std::string out = ::testing::TempDir() + "companion-eval-recorded";
-  ChildProcess p({COMPANION_EVAL_PATH, "--pedestrians", COMPANION_PEDESTRIANS "/biwi_hotel.txt",
-                  "--frame-period", "0.4", "--follow", "203", "--method", "objective",
-                  "--duration-s", "8", "--out", out});
+  ChildProcess p({COMPANION_EVAL_PATH, "--pedestrians", kBiwiHotel, "--frame-period", "0.4",
+                  "--follow", "203", "--method", "objective", "--duration-s", "8", "--out", out});
   ASSERT_TRUE(p.started());
   ASSERT_EQ(p.wait(300s), 0) << p.output();
   const std::string csv = slurp(out + "/trials.csv");
@@ -168,9 +170,8 @@ TEST(CompanionEval, FollowsARecordedPersonFromAnyDatasetFile) {
 
   // --walkers: the three who walk farthest in biwi_hotel (14.0, 13.9, 13.8 m), one trial each.
   const std::string out3 = ::testing::TempDir() + "companion-eval-recorded-3";
-  ChildProcess q({COMPANION_EVAL_PATH, "--pedestrians", COMPANION_PEDESTRIANS "/biwi_hotel.txt",
-                  "--frame-period", "0.4", "--walkers", "3", "--method", "objective",
-                  "--duration-s", "2", "--out", out3});
+  ChildProcess q({COMPANION_EVAL_PATH, "--pedestrians", kBiwiHotel, "--frame-period", "0.4",
+                  "--walkers", "3", "--method", "objective", "--duration-s", "2", "--out", out3});
   ASSERT_TRUE(q.started());
   ASSERT_EQ(q.wait(300s), 0) << q.output();
   const std::string csv3 = slurp(out3 + "/trials.csv");
@@ -198,9 +199,8 @@ TEST(CompanionEval, RefusesUnknownCasesMethodsAndPersons) {
   expect_refused({"--case", "moon"}, "unknown case 'moon'");
   expect_refused({"--method", "teleport"}, "unknown method 'teleport'");
   expect_refused({"--method", "policy"}, "needs a policy file");
-  const std::string biwi = COMPANION_PEDESTRIANS "/biwi_hotel.txt";
-  expect_refused({"--pedestrians", biwi, "--follow", "99999"}, "no person with id 99999");
-  expect_refused({"--pedestrians", biwi, "--follow", "203", "--walkers", "2"},
+  expect_refused({"--pedestrians", kBiwiHotel, "--follow", "99999"}, "no person with id 99999");
+  expect_refused({"--pedestrians", kBiwiHotel, "--follow", "203", "--walkers", "2"},
                  "--follow names one person");
-  expect_refused({"--pedestrians", biwi, "--walkers", "9999"}, "9999 asked for");
+  expect_refused({"--pedestrians", kBiwiHotel, "--walkers", "9999"}, "9999 asked for");
 }
