@@ -63,6 +63,7 @@ SimWorld::SimWorld(Scenario scenario, const SimWorldConfig& config, hal::Clock& 
   for (const Pedestrian& p : scenario_.pedestrians)
     crowd_.add(p);
   person_ = scenario_.person.pose_at(0.0);
+  replayed_.resize(scenario_.replayed.size());
   prev_robot_ = scenario_.robot_start;
 }
 
@@ -133,7 +134,6 @@ void SimWorld::move_person(double t_s, double dt_s) {
 }
 
 void SimWorld::move_replayed(double t_s, double dt_s) {
-  replayed_.resize(scenario_.replayed.size());
   for (size_t i = 0; i < scenario_.replayed.size(); ++i) {
     const Trajectory& r = scenario_.replayed[i];
     std::optional<ScriptedWalker>& w = replayed_[i];
@@ -160,7 +160,7 @@ Point2 SimWorld::footprint_normal(const Point2& p) const {
                  std::clamp(q.y_m, config_.footprint_y_min_m, config_.footprint_y_max_m)};
   double nx = q.x_m - c.x_m, ny = q.y_m - c.y_m;
   double n_len = std::hypot(nx, ny);
-  if (n_len < 1e-9) {  // inside (the robot drove into them): away from its centre
+  if (n_len < 1e-9) {  // inside (the robot drove into them, or they appeared there): outward
     nx = q.x_m;
     ny = q.y_m;
     n_len = std::max(std::hypot(nx, ny), 1e-9);

@@ -84,8 +84,14 @@ std::vector<core::Point2> observation_velocities(const std::vector<TimedPose>& o
   for (size_t k = 1; k + 1 < n; ++k) {
     const double h0 = obs[k].t_s - obs[k - 1].t_s;
     const double h1 = obs[k + 1].t_s - obs[k].t_s;
-    if (h0 > kMaxSmoothGapS || h1 > kMaxSmoothGapS) {  // a track's end beside a gap
-      v[k] = h1 > kMaxSmoothGapS ? (h0 > kMaxSmoothGapS ? core::Point2{} : chord[k - 1]) : chord[k];
+    // Beside a gap the observation is a track's end: its one chord (none between two gaps).
+    if (h0 > kMaxSmoothGapS && h1 > kMaxSmoothGapS) continue;
+    if (h1 > kMaxSmoothGapS) {
+      v[k] = chord[k - 1];
+      continue;
+    }
+    if (h0 > kMaxSmoothGapS) {
+      v[k] = chord[k];
       continue;
     }
     const double w0 = h1 / (h0 + h1);  // the nearer neighbour's chord counts more
