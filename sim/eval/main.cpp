@@ -19,6 +19,7 @@
 #include <iostream>
 #include <map>
 #include <mutex>
+#include <numbers>
 #include <thread>
 
 #include "eval_plan.hpp"
@@ -192,6 +193,12 @@ int run(int argc, char** argv) {
                "recorded pedestrians keep to their recording even into the robot (default: "
                "they do not walk into it, as the followed person; the recorded tables up to the "
                "thirty-seventh session)");
+  double person_sway_deg = 0;
+  app.add_option("--person-sway-deg", person_sway_deg,
+                 "the worn sensor sways with the person's gait by this much either side of their "
+                 "heading, one cycle per 1.4 m stride (its yaw and gyro; about 4 at the belt or "
+                 "chest; default 0)")
+      ->check(CLI::Range(0.0, 30.0));
   std::vector<double> costmap_at;
   app.add_option("--costmap-at", costmap_at,
                  "write the daemon's costmap at these times (s) of each trial as map_server maps "
@@ -303,6 +310,7 @@ int run(int argc, char** argv) {
       o.duration_s = duration_s;
       o.person_avoids_robot = !person_walks_through;
       o.replayed_avoid_robot = !recorded_walk_through;
+      o.person_sway_rad = person_sway_deg * std::numbers::pi / 180.0;
       if (!costmap_at.empty()) {
         std::filesystem::create_directories(out_dir + "/costmaps");
         o.costmap_at_s = costmap_at;

@@ -64,7 +64,10 @@ void put_u32(std::vector<uint8_t>& v, uint32_t x) {
 }  // namespace
 
 SimAmfitrack::SimAmfitrack(const SimAmfitrackConfig& config)
-    : config_(config), q_(std::make_shared<Queues>()), rng_(config.seed) {}
+    : config_(config),
+      q_(std::make_shared<Queues>()),
+      rng_(config.seed),
+      gyro_rng_(config.seed ^ 0x9e3779b9U) {}
 
 void SimAmfitrack::set_sensor_pose(double x_m, double y_m, double z_m, double yaw_rad) {
   position_m_ = {x_m, y_m, z_m};
@@ -108,6 +111,10 @@ am::SensorMeasurement SimAmfitrack::measurement() {
   m.tracked_source = config_.source_tx_id;
   m.accel_g = {0, 0, 1};
   m.gyro_dps = gyro_dps_;
+  if (config_.gyro_noise_dps > 0) {
+    for (double& v : m.gyro_dps)
+      v += config_.gyro_noise_dps * gyro_unit_(gyro_rng_);
+  }
   m.temperature_c = 31.0;
   m.pose_state_raw = pose_state_;
   m.quality_raw = quality_;

@@ -24,6 +24,7 @@ SimWorldConfig world_config(const firmware::DaemonConfig& cfg, uint32_t seed) {
   w.tracker.seed = seed;
   w.tracker.position_noise_m = 0.01;
   w.tracker.heading_noise_rad = 0.02;
+  w.tracker.gyro_noise_dps = 0.3;  // a MEMS gyro's white noise at 120 Hz (about 0.005 rad/s)
   w.tracker_extrinsics = firmware::tracker_extrinsics(cfg);
   w.lidar.seed = seed;
   w.lidar.mount_x_m = cfg.lidar.x_m;
@@ -127,6 +128,7 @@ SimRunResult run_simulation(const SimRunOptions& o) {
   SimWorldConfig world_cfg = world_config(o.config, o.seed);
   world_cfg.person_avoids_robot = o.person_avoids_robot;
   world_cfg.replayed_avoid_robot = o.replayed_avoid_robot;
+  world_cfg.person_sway_rad = o.person_sway_rad;
   SimWorld world(o.scenario, world_cfg, clock);
   firmware::DaemonConfig cfg = o.config;
   cfg.mppi.seed = o.seed;

@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include "hal/serial_port.hpp"
 
@@ -236,6 +237,14 @@ SimWorld::ScriptedWalker SimWorld::step_clear_of_robot(const ScriptedWalker& w,
 void SimWorld::advance(double t_s) {
   const double dt = t_s - t_s_;
   move_person(t_s, dt);
+  if (dt > 0) {
+    person_yaw_rate_radps_ = scenario_.person.turn_rate_at(t_s);
+    sway_phase_rate_radps_ =
+        2.0 * std::numbers::pi * std::hypot(person_velocity_.x_m, person_velocity_.y_m) /
+        config_.person_stride_m;
+    sway_phase_rad_ =
+        std::fmod(sway_phase_rad_ + sway_phase_rate_radps_ * dt, 2.0 * std::numbers::pi);
+  }
   move_replayed(t_s, dt);
   if (dt > 0) {
     const core::Pose2 robot = robot_pose();
@@ -257,11 +266,20 @@ void SimWorld::update_tracker_pose() {
   const core::Pose2 rel = robot_pose().inverse() * person_;
   const Eigen::Vector3d p_base(rel.x_m, rel.y_m, config_.sensor_height_m);
   const Eigen::Vector3d p_source = r_base_source_.transpose() * (p_base - t_base_source_);
+  const double sway_rad = config_.person_sway_rad * std::sin(sway_phase_rad_);
   const Eigen::Matrix3d r_base_body =
-      Eigen::AngleAxisd(rel.theta_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+      Eigen::AngleAxisd(rel.theta_rad + sway_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   const Eigen::Quaterniond q(r_base_source_.transpose() * r_base_body * r_body_sensor_);
   tracker_.set_sensor_pose({p_source.x(), p_source.y(), p_source.z()},
                            {q.x(), q.y(), q.z(), q.w()});
+  // The gyro: the torso turns about the vertical at the walking heading's rate plus the sway's,
+  // whatever the robot does (a gyro is inertial); in the sensor's own axes.
+  const double body_rate_radps =
+      person_yaw_rate_radps_ +
+      config_.person_sway_rad * std::cos(sway_phase_rad_) * sway_phase_rate_radps_;
+  const Eigen::Vector3d gyro_dps =
+      r_body_sensor_.transpose() * Eigen::Vector3d(0, 0, body_rate_radps * 180.0 / std::numbers::pi);
+  tracker_.set_gyro_dps({gyro_dps.x(), gyro_dps.y(), gyro_dps.z()});
 }
 
 void SimWorld::step(hal::Nanos now) {

@@ -33,6 +33,17 @@ core::Point2 Trajectory::velocity_at(double t_s) const {
   return {(b.pose.x_m - a.pose.x_m) / span, (b.pose.y_m - a.pose.y_m) / span};
 }
 
+double Trajectory::turn_rate_at(double t_s) const {
+  if (samples_.size() < 2 || t_s < samples_.front().t_s || t_s >= samples_.back().t_s) return 0;
+  const auto it = std::upper_bound(samples_.begin(), samples_.end(), t_s,
+                                   [](double t, const TimedPose& s) { return t < s.t_s; });
+  const TimedPose& b = *it;
+  const TimedPose& a = *(it - 1);
+  const double span = b.t_s - a.t_s;
+  if (span <= 0) return 0;
+  return core::wrap_angle(b.pose.theta_rad - a.pose.theta_rad) / span;
+}
+
 void set_headings_from_motion(std::vector<TimedPose>& samples) {
   // Below this speed a person is standing: recorded positions then jitter by centimetres and
   // their direction means nothing, so the heading is kept.

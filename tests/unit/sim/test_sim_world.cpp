@@ -23,6 +23,7 @@
 #include "sim/run_metrics.hpp"
 #include "sim/run_report.hpp"
 #include "sim/scenario.hpp"
+#include "sim/sim_amfitrack.hpp"
 #include "sim/sim_run.hpp"
 #include "sim/sim_vlp16.hpp"
 #include "sim/sim_world.hpp"
@@ -672,6 +673,143 @@ TEST(SimWorld, TrackerFramesPlaceThePersonWhereTheWorldHasThem) {
     }
   }
   EXPECT_NEAR(frames, 60, 1) << "120 Hz";
+}
+
+namespace {
+// Every tracker frame of a world run for `ms` with the robot standing, read back through the
+// real decoder and person frame, with the world's truth (base_link) when it was sent.
+struct ReadBack {
+  double t_s = 0;  // world time of the step that sent it
+  amfitrack::PersonInBase person;
+  Pose2 truth;
+};
+std::vector<ReadBack> read_back_tracker(const sim::Scenario& s, const sim::SimWorldConfig& cfg,
+                                        int ms) {
+  hal::SimClock clock;
+  sim::SimWorld world(s, cfg, clock);
+  auto link = world.take_tracker_link();
+  const amfitrack::PersonFrame frame(cfg.tracker_extrinsics);
+  std::vector<ReadBack> out;
+  for (int t = 0; t <= ms; t += 5) {
+    world.step(std::chrono::milliseconds(t));
+    const Pose2 truth = world.robot_pose().inverse() * world.person_pose();
+    while (auto p = link->receive()) {
+      const auto parsed = amfitrack::decode_payload(*p);
+      if (!parsed.payload) continue;
+      const auto* m = std::get_if<amfitrack::SensorMeasurement>(&*parsed.payload);
+      if (m == nullptr) continue;
+      const auto person = frame.to_base(*m);
+      if (person) out.push_back({world.time_s(), *person, truth});
+    }
+  }
+  return out;
+}
+
+// A person walking a circle of `radius_m` about (cx, cy) at `speed_mps`, counter-clockwise.
+sim::Scenario circle_walker(double cx, double cy, double radius_m, double speed_mps) {
+  std::vector<sim::TimedPose> samples;
+  const double rate = speed_mps / radius_m;
+  for (int i = 0; i <= 200; ++i) {
+    const double t = 0.05 * i;
+    const double a = rate * t;
+    samples.push_back({t, Pose2{cx + radius_m * std::cos(a), cy + radius_m * std::sin(a),
+                                a + std::numbers::pi / 2}});
+  }
+  sim::Scenario s;
+  s.name = "circle";
+  s.person = sim::Trajectory(std::move(samples));
+  s.robot_start = Pose2{0.0, 0.0, 0.4};
+  return s;
+}
+}  // namespace
+
+TEST(SimWorld, TheWornSensorsGyroReadsThePersonsTurnRateInItsOwnAxes) {
+  // 1 m/s round a 2 m circle: 0.5 rad/s. The sensor is worn on its side (rolled 90 degrees), so
+  // the turn is about its y axis: the person frame must rotate it back to base_link's z.
+  const sim::Scenario s = circle_walker(4.0, 0.0, 2.0, 1.0);
+  sim::SimWorldConfig cfg;
+  cfg.tracker_extrinsics.sensor_in_body_rpy_rad = {std::numbers::pi / 2, 0.0, 0.0};
+  const auto frames = read_back_tracker(s, cfg, 2000);
+  ASSERT_GT(frames.size(), 200U);
+  for (size_t i = 12; i < frames.size(); ++i) {  // from 0.1 s (the first step has no rate)
+    EXPECT_NEAR(frames[i].person.yaw_rate_radps, 0.5, 0.002) << "frame " << i;
+    EXPECT_NEAR(core::wrap_angle(frames[i].person.heading_rad - frames[i].truth.theta_rad), 0.0,
+                1e-3);
+  }
+}
+
+TEST(SimWorld, TheWornSensorSwaysWithTheGaitAndItsGyroWithIt) {
+  // Walking straight at 1.4 m/s: one 1.4 m stride a second, the sensor's yaw +-0.07 rad about
+  // the walking heading and its gyro the sway's rate, 0.07 * 2 pi = 0.44 rad/s at its peak.
+  sim::Scenario s;
+  s.name = "straight";
+  s.person = sim::walk({{{2.0, -3.0}}, {{2.0, 20.0}, 1.4}}, 0.0, 0.05, {});
+  s.robot_start = Pose2{0.0, 0.0, 0.0};
+  sim::SimWorldConfig cfg;
+  cfg.person_sway_rad = 0.07;
+  const auto frames = read_back_tracker(s, cfg, 3000);
+  ASSERT_GT(frames.size(), 300U);
+  double sway_min = 1, sway_max = -1, rate_max = 0, heading_drift = 0;
+  for (size_t i = 12; i < frames.size(); ++i) {
+    const double sway = core::wrap_angle(frames[i].person.heading_rad - frames[i].truth.theta_rad);
+    sway_min = std::min(sway_min, sway);
+    sway_max = std::max(sway_max, sway);
+    rate_max = std::max(rate_max, std::abs(frames[i].person.yaw_rate_radps));
+    // The gyro, integrated frame to frame, turns the sensor as its yaw does.
+    const double integrated =
+        frames[i - 1].person.yaw_rate_radps * (frames[i].t_s - frames[i - 1].t_s);
+    const double turned =
+        core::wrap_angle(frames[i].person.heading_rad - frames[i - 1].person.heading_rad);
+    heading_drift = std::max(heading_drift, std::abs(turned - integrated));
+  }
+  EXPECT_NEAR(sway_max, 0.07, 0.003);
+  EXPECT_NEAR(sway_min, -0.07, 0.003);
+  EXPECT_NEAR(rate_max, 0.07 * 2 * std::numbers::pi, 0.01);
+  EXPECT_LT(heading_drift, 0.001) << "the gyro and the yaw tell one story";
+
+  // Without sway the sensor faces the walking heading and its gyro reads nothing.
+  cfg.person_sway_rad = 0.0;
+  for (const ReadBack& f : read_back_tracker(s, cfg, 1000)) {
+    EXPECT_NEAR(core::wrap_angle(f.person.heading_rad - f.truth.theta_rad), 0.0, 1e-3);
+    EXPECT_NEAR(f.person.yaw_rate_radps, 0.0, 1e-3);
+  }
+}
+
+TEST(SimAmfitrack, GyroNoiseHasItsOwnGeneratorSoThePoseNoiseIsUnchanged) {
+  sim::SimAmfitrackConfig quiet;
+  quiet.position_noise_m = 0.01;
+  quiet.heading_noise_rad = 0.02;
+  sim::SimAmfitrackConfig noisy = quiet;
+  noisy.gyro_noise_dps = 1.0;
+  sim::SimAmfitrack a(quiet);
+  sim::SimAmfitrack b(noisy);
+  a.set_gyro_dps({0, 0, 10.0});
+  b.set_gyro_dps({0, 0, 10.0});
+  auto la = a.host_link();
+  auto lb = b.host_link();
+  double sum2 = 0;
+  int n = 0;
+  for (int ms = 0; ms <= 10000; ms += 5) {
+    a.step(std::chrono::milliseconds(ms));
+    b.step(std::chrono::milliseconds(ms));
+    while (auto pa = la->receive()) {
+      auto pb = lb->receive();
+      ASSERT_TRUE(pb);
+      const auto da = amfitrack::decode_payload(*pa);
+      const auto db = amfitrack::decode_payload(*pb);
+      if (!da.payload || !db.payload) continue;
+      const auto* ma = std::get_if<amfitrack::SensorMeasurement>(&*da.payload);
+      const auto* mb = std::get_if<amfitrack::SensorMeasurement>(&*db.payload);
+      if (ma == nullptr || mb == nullptr) continue;
+      EXPECT_EQ(ma->position_m, mb->position_m);
+      EXPECT_EQ(ma->quaternion_xyzw, mb->quaternion_xyzw);
+      EXPECT_NEAR(ma->gyro_dps[2], 10.0, 0.04);  // the wire's 0.07 dps steps
+      sum2 += (mb->gyro_dps[2] - 10.0) * (mb->gyro_dps[2] - 10.0);
+      ++n;
+    }
+  }
+  ASSERT_GT(n, 1000);
+  EXPECT_NEAR(std::sqrt(sum2 / n), 1.0, 0.1);
 }
 
 namespace {

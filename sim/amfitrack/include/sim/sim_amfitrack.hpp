@@ -28,6 +28,9 @@ struct SimAmfitrackConfig {
   double rate_hz = 120.0;
   double position_noise_m = 0.0;  // 1-sigma per axis, white
   double heading_noise_rad = 0.0;
+  // The sensor's IMU: white noise on each gyro axis (1-sigma). Drawn from a generator of its
+  // own, so turning it on leaves the pose noise's sequence as it was.
+  double gyro_noise_dps = 0.0;
   uint32_t seed = 1;
   std::string source_name = "AMFITRACK SOURCE";
   std::string sensor_name = "AMFITRACK SENSOR";
@@ -43,6 +46,7 @@ class SimAmfitrack {
   void set_sensor_pose(double x_m, double y_m, double z_m, double yaw_rad);
   void set_sensor_pose(const std::array<double, 3>& position_m,
                        const std::array<double, 4>& quaternion_xyzw);
+  // The sensor's angular velocity in its own frame (what its gyro measures), degrees/s.
   void set_gyro_dps(const std::array<double, 3>& gyro) { gyro_dps_ = gyro; }
   void set_quality(uint8_t raw) { quality_ = raw; }
   void set_pose_state(uint8_t raw) { pose_state_ = raw; }  // 1 tracking, 0 none, 2 uncertain
@@ -79,6 +83,8 @@ class SimAmfitrack {
   amfitrack::CobsStreamDecoder cobs_in_;
   std::vector<uint8_t> cobs_out_;
   std::mt19937 rng_;
+  std::mt19937 gyro_rng_;
+  std::normal_distribution<double> gyro_unit_{0.0, 1.0};  // its own: the draws come in pairs
   std::normal_distribution<double> unit_{0.0, 1.0};
   std::array<double, 3> position_m_{1.0, 0.0, 0.0};
   std::array<double, 4> quaternion_xyzw_{0, 0, 0, 1};

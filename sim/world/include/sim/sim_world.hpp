@@ -27,6 +27,12 @@ struct SimWorldConfig {
   SimVlp16Config lidar;
   amfitrack::TrackerExtrinsics tracker_extrinsics;  // the daemon's tracker.* keys
   double sensor_height_m = 1.0;                     // the worn sensor above the ground
+  // The worn sensor turns with the torso, which sways about the way the person walks (about
+  // +-4 degrees at the belt or chest, one cycle per stride): its yaw is their heading plus
+  // person_sway_rad sin(phase), the phase advancing 2 pi per person_stride_m walked, and its
+  // gyro reads the sway's rate too. The metrics' person is the walking heading. 0: no sway.
+  double person_sway_rad = 0.0;
+  double person_stride_m = 1.4;
   // The robot's footprint in base_link (collisions): the daemon's costmap.footprint_* keys.
   double footprint_x_min_m = -0.35, footprint_x_max_m = 0.35;
   double footprint_y_min_m = -0.30, footprint_y_max_m = 0.30;
@@ -134,6 +140,9 @@ class SimWorld {
   Eigen::Matrix3d r_base_source_;
   Eigen::Vector3d t_base_source_;
   Eigen::Matrix3d r_body_sensor_;
+  double person_yaw_rate_radps_ = 0;  // of the walking heading (Trajectory::turn_rate_at)
+  double sway_phase_rad_ = 0;
+  double sway_phase_rate_radps_ = 0;
 
   bool lidar_silent_ = false;
   bool started_ = false;

@@ -21,6 +21,9 @@ class Trajectory {
 
   [[nodiscard]] core::Pose2 pose_at(double t_s) const;
   [[nodiscard]] core::Point2 velocity_at(double t_s) const;  // m/s, world frame
+  // rad/s (+ left) of the sample step at t_s: how fast the walker turns there. pose_at holds a
+  // step's heading and turns at its end (a staircase); this is the turn the steps are made of.
+  [[nodiscard]] double turn_rate_at(double t_s) const;
   [[nodiscard]] double start_s() const { return samples_.empty() ? 0.0 : samples_.front().t_s; }
   [[nodiscard]] double end_s() const { return samples_.empty() ? 0.0 : samples_.back().t_s; }
   [[nodiscard]] bool empty() const { return samples_.empty(); }
