@@ -110,10 +110,9 @@ am::SensorMeasurement SimAmfitrack::measurement() {
                                          (static_cast<uint8_t>(bfield_) << 4));
   m.tracked_source = config_.source_tx_id;
   m.accel_g = {0, 0, 1};
-  m.gyro_dps = gyro_dps_;
-  if (config_.gyro_noise_dps > 0) {
-    for (double& v : m.gyro_dps)
-      v += config_.gyro_noise_dps * gyro_unit_(gyro_rng_);
+  for (size_t i = 0; i < 3; ++i) {
+    m.gyro_dps[i] = gyro_dps_[i] + config_.gyro_bias_dps[i];
+    if (config_.gyro_noise_dps > 0) m.gyro_dps[i] += config_.gyro_noise_dps * gyro_unit_(gyro_rng_);
   }
   m.temperature_c = 31.0;
   m.pose_state_raw = pose_state_;

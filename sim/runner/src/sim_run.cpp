@@ -24,7 +24,10 @@ SimWorldConfig world_config(const firmware::DaemonConfig& cfg, uint32_t seed) {
   w.tracker.seed = seed;
   w.tracker.position_noise_m = 0.01;
   w.tracker.heading_noise_rad = 0.02;
-  w.tracker.gyro_noise_dps = 0.3;  // a MEMS gyro's white noise at 120 Hz (about 0.005 rad/s)
+  // A MEMS gyro as it comes: white noise at 120 Hz (about 0.005 rad/s) and an uncalibrated
+  // bias of half a degree a second per axis (the daemon reads the gyro with human.use_gyro).
+  w.tracker.gyro_noise_dps = 0.3;
+  w.tracker.gyro_bias_dps = {0.5, -0.5, 0.5};
   w.tracker_extrinsics = firmware::tracker_extrinsics(cfg);
   w.lidar.seed = seed;
   w.lidar.mount_x_m = cfg.lidar.x_m;

@@ -211,6 +211,35 @@ TEST(HumanEkf, GyroYawRateSharpensTheTurnRate) {
   EXPECT_GT(with_gyro.counters().yaw_rate_updates, 400U);
 }
 
+TEST(HumanEkf, TheGyroCarriesATurnFromItsFirstFrame) {
+  // Straight for 2 s, then a 3 rad/s corner at once. The gyro is not the field's measurement: a
+  // turn rate far from the filter's is the person turning, not an outlier to gate away (the
+  // chi-square gate held the first ~0.1 s of every corner back, when it matters most).
+  const auto truth = walk({{2.0, 1.2, 0.0}, {0.5, 1.2, 3.0}});
+  core::HumanEkf ekf(core::HumanEkfConfig{});
+  std::mt19937 rng(7);
+  std::normal_distribution<double> n(0, 0.01);
+  std::normal_distribution<double> nh(0, 0.02);
+  size_t corner = 0;
+  for (size_t i = 0; i < truth.size(); ++i) {
+    const Nanos t = kFrame * static_cast<int64_t>(i);
+    const Pose2 z{truth[i].pose.x_m + n(rng), truth[i].pose.y_m + n(rng),
+                  truth[i].pose.theta_rad + nh(rng)};
+    ekf.update_pose(z, true, t);
+    const double rate = i >= 240 ? 3.0 : 0.0;
+    EXPECT_EQ(ekf.update_yaw_rate(rate, t), core::UpdateResult::kAccepted) << "frame " << i;
+    if (i == 243) corner = i;
+    if (corner != 0 && i == corner) {
+      EXPECT_GT(ekf.track().mean()(5), 2.7) << "three frames (25 ms) into the corner";
+    }
+  }
+  EXPECT_EQ(ekf.counters().rejected, 0U);
+  // A rate no person turns at is refused and counted, not taken.
+  const Nanos t = kFrame * static_cast<int64_t>(truth.size());
+  EXPECT_EQ(ekf.update_yaw_rate(50.0, t), core::UpdateResult::kRejected);
+  EXPECT_EQ(ekf.counters().rejected, 1U);
+}
+
 TEST(HumanEkf, PredictsToQueryTimesAndIntoTheRobotFrame) {
   core::HumanTrack track;
   track.valid = true;

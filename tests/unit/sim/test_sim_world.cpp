@@ -775,19 +775,20 @@ TEST(SimWorld, TheWornSensorSwaysWithTheGaitAndItsGyroWithIt) {
   }
 }
 
-TEST(SimAmfitrack, GyroNoiseHasItsOwnGeneratorSoThePoseNoiseIsUnchanged) {
+TEST(SimAmfitrack, GyroBiasAndNoiseLeaveThePoseNoiseAsItWas) {
   sim::SimAmfitrackConfig quiet;
   quiet.position_noise_m = 0.01;
   quiet.heading_noise_rad = 0.02;
   sim::SimAmfitrackConfig noisy = quiet;
   noisy.gyro_noise_dps = 1.0;
+  noisy.gyro_bias_dps = {0, 0, 2.0};
   sim::SimAmfitrack a(quiet);
   sim::SimAmfitrack b(noisy);
   a.set_gyro_dps({0, 0, 10.0});
   b.set_gyro_dps({0, 0, 10.0});
   auto la = a.host_link();
   auto lb = b.host_link();
-  double sum2 = 0;
+  double sum = 0, sum2 = 0;
   int n = 0;
   for (int ms = 0; ms <= 10000; ms += 5) {
     a.step(std::chrono::milliseconds(ms));
@@ -804,12 +805,15 @@ TEST(SimAmfitrack, GyroNoiseHasItsOwnGeneratorSoThePoseNoiseIsUnchanged) {
       EXPECT_EQ(ma->position_m, mb->position_m);
       EXPECT_EQ(ma->quaternion_xyzw, mb->quaternion_xyzw);
       EXPECT_NEAR(ma->gyro_dps[2], 10.0, 0.04);  // the wire's 0.07 dps steps
+      sum += mb->gyro_dps[2] - 10.0;
       sum2 += (mb->gyro_dps[2] - 10.0) * (mb->gyro_dps[2] - 10.0);
       ++n;
     }
   }
   ASSERT_GT(n, 1000);
-  EXPECT_NEAR(std::sqrt(sum2 / n), 1.0, 0.1);
+  const double bias = sum / n;
+  EXPECT_NEAR(bias, 2.0, 0.1);
+  EXPECT_NEAR(std::sqrt(sum2 / n - bias * bias), 1.0, 0.1);
 }
 
 namespace {

@@ -80,7 +80,8 @@ class HumanEkf {
 
   // Person pose in odom at `stamp`. `heading_valid` false: position only.
   UpdateResult update_pose(const Pose2& person_in_odom, bool heading_valid, Nanos stamp);
-  // Yaw rate of the person (rad/s, about z) at `stamp`.
+  // Yaw rate of the person (rad/s, about z) at `stamp`, from the worn sensor's gyro: taken unless
+  // no person turns that fast (10 rad/s; not the poses' chi-square gate: a gyro is inertial).
   UpdateResult update_yaw_rate(double yaw_rate_radps, Nanos stamp);
 
   [[nodiscard]] const HumanTrack& track() const { return track_; }

@@ -28,8 +28,9 @@ struct SimAmfitrackConfig {
   double rate_hz = 120.0;
   double position_noise_m = 0.0;  // 1-sigma per axis, white
   double heading_noise_rad = 0.0;
-  // The sensor's IMU: white noise on each gyro axis (1-sigma). Drawn from a generator of its
-  // own, so turning it on leaves the pose noise's sequence as it was.
+  // The sensor's IMU: a constant bias and white noise (1-sigma) on each gyro axis. Drawn from
+  // a generator of its own, so turning it on leaves the pose noise's sequence as it was.
+  std::array<double, 3> gyro_bias_dps{0, 0, 0};
   double gyro_noise_dps = 0.0;
   uint32_t seed = 1;
   std::string source_name = "AMFITRACK SOURCE";
