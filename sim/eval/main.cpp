@@ -179,7 +179,13 @@ int run(int argc, char** argv) {
       ->check(CLI::Range(1, 10000));
   app.add_option("--duration-s", duration_s, "cut every trial to this long (0: the scenario's)")
       ->check(CLI::NonNegativeNumber);
-  app.add_flag("--samples", samples, "also write each trial's samples (100 ms) for the plots");
+  app.add_flag("--samples", samples,
+               "also write each trial's samples (every --sample-period-s) for the plots");
+  double sample_period_s = 0.1;
+  app.add_option("--sample-period-s", sample_period_s,
+                 "seconds between samples (default 0.1; 0.01 to see the 100 Hz control's "
+                 "answer to a turn: sim/eval/turn_lag.py)")
+      ->check(CLI::Range(0.005, 10.0));
   bool daemon_log = false;
   app.add_flag("--daemon-log", daemon_log,
                "print the daemons' log (info: every failsafe transition) to diagnose a trial; "
@@ -311,6 +317,7 @@ int run(int argc, char** argv) {
       o.person_avoids_robot = !person_walks_through;
       o.replayed_avoid_robot = !recorded_walk_through;
       o.person_sway_rad = person_sway_deg * std::numbers::pi / 180.0;
+      o.sample_period_s = sample_period_s;
       if (!costmap_at.empty()) {
         std::filesystem::create_directories(out_dir + "/costmaps");
         o.costmap_at_s = costmap_at;

@@ -141,12 +141,15 @@ void RunMetricsRecorder::record(double t_s, double dt_s, const core::Pose2& robo
     s.side = view.side;
     s.cmd_vx_mps = view.cmd_vx;
     s.cmd_vy_mps = view.cmd_vy;
+    s.cmd_wz_radps = view.cmd_wz;
     const double none = std::nan("");
+    s.person_est_theta_rad = view.has_person_estimate ? view.person_est_theta : none;
+    s.person_est_yaw_rate_radps = view.has_person_estimate ? view.person_est_yaw_rate : none;
     s.plan_tracking = view.tracking ? view.plan_tracking : none;
     s.plan_collision = view.tracking ? view.plan_collision : none;
     s.plan_barrier = view.tracking ? view.plan_barrier : none;
     samples_.push_back(std::move(s));
-    next_sample_s_ = t_s + config_.sample_period_s;
+    next_sample_s_ = t_s + config_.sample_period_s - 1e-9;  // a step's rounding: not a skip
   }
 }
 

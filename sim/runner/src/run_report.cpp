@@ -243,7 +243,7 @@ std::string samples_csv(const std::vector<RunSample>& samples) {
       "t_s,robot_x_m,robot_y_m,robot_theta_rad,person_x_m,person_y_m,person_theta_rad,active,"
       "has_goal,goal_x_m,goal_y_m,side,pedestrians,nearest_pedestrian_x_m,nearest_pedestrian_y_m,"
       "nearest_pedestrian_m,cmd_vx_mps,cmd_vy_mps,plan_tracking_cost,plan_collision_cost,"
-      "plan_barrier_cost\n";
+      "plan_barrier_cost,cmd_wz_radps,person_est_theta_rad,person_est_yaw_rate_radps\n";
   for (const RunSample& s : samples) {
     // The pedestrian nearest the robot (centres): where the close calls were.
     core::Point2 nearest{std::nan(""), std::nan("")};
@@ -257,11 +257,12 @@ std::string samples_csv(const std::vector<RunSample>& samples) {
     }
     out += fmt::format(
         "{:.3f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{},{},{:.4f},{:.4f},{},{},{:.4f},{:.4f},"
-        "{:.4f},{:.3f},{:.3f},{:.1f},{:.1f},{:.1f}\n",
+        "{:.4f},{:.3f},{:.3f},{:.1f},{:.1f},{:.1f},{:.4f},{:.4f},{:.4f}\n",
         s.t_s, s.robot.x_m, s.robot.y_m, s.robot.theta_rad, s.person.x_m, s.person.y_m,
         s.person.theta_rad, s.active ? 1 : 0, s.has_goal ? 1 : 0, s.goal.x_m, s.goal.y_m, s.side,
         s.pedestrians.size(), nearest.x_m, nearest.y_m, nearest_m, s.cmd_vx_mps, s.cmd_vy_mps,
-        s.plan_tracking, s.plan_collision, s.plan_barrier);
+        s.plan_tracking, s.plan_collision, s.plan_barrier, s.cmd_wz_radps, s.person_est_theta_rad,
+        s.person_est_yaw_rate_radps);
   }
   return out;
 }

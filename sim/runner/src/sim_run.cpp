@@ -59,6 +59,12 @@ DaemonView daemon_view(const firmware::Daemon& daemon) {
   if (const auto c = daemon.command().read()) {
     v.cmd_vx = c->value.vx_mps;
     v.cmd_vy = c->value.vy_mps;
+    v.cmd_wz = c->value.wz_radps;
+  }
+  if (const auto t = daemon.human_track().read(); t && t->value.valid) {
+    v.has_person_estimate = true;
+    v.person_est_theta = t->value.mean_data[2];
+    v.person_est_yaw_rate = t->value.mean_data[5];
   }
   if (const auto c = daemon.control_status().read(); c && c->value.tracking) {
     v.tracking = true;
@@ -148,8 +154,11 @@ SimRunResult run_simulation(const SimRunOptions& o) {
   daemon.attach_lidar(world.take_lidar_source());
   std::unique_ptr<hal::VirtualCanBus> sniffer = world.open_can_sniffer();
 
-  RunMetricsRecorder recorder(
-      MetricsConfig{cfg.interactive_space.ellipse_a_m, cfg.interactive_space.ellipse_b_m});
+  MetricsConfig metrics_cfg;
+  metrics_cfg.ellipse_a_m = cfg.interactive_space.ellipse_a_m;
+  metrics_cfg.ellipse_b_m = cfg.interactive_space.ellipse_b_m;
+  metrics_cfg.sample_period_s = o.sample_period_s;
+  RunMetricsRecorder recorder(metrics_cfg);
   auto tasks = daemon.bindings();
   for (auto& t : tasks) {
     // Wall time of the planning tasks (the simulated clock does not advance inside a task).

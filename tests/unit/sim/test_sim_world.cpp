@@ -1000,21 +1000,39 @@ TEST(RunMetrics, SamplesCarryTheDaemonsCommandAndPlanCostsToDiagnoseATrial) {
   v.active = true;
   v.cmd_vx = 0.75;
   v.cmd_vy = -0.25;
+  v.cmd_wz = 0.5;
+  v.has_person_estimate = true;
+  v.person_est_theta = 1.25;
+  v.person_est_yaw_rate = -0.125;
   v.tracking = true;
   v.plan_tracking = 12.5;
   v.plan_collision = 3000.0;
   v.plan_barrier = 0.0;
   r.record(0.0, 0.01, Pose2{-1, 0, 0}, Pose2{0, 0, 0}, {}, 5.0, 1.0, v);
-  v.tracking = false;  // holding: no plan
+  v.tracking = false;             // holding: no plan
+  v.has_person_estimate = false;  // and no track
   r.record(0.2, 0.01, Pose2{-1, 0, 0}, Pose2{0, 0, 0}, {}, 5.0, 1.0, v);
   ASSERT_EQ(r.samples().size(), 2U);
   const std::string csv = sim::samples_csv(r.samples());
-  EXPECT_NE(
-      csv.find(",cmd_vx_mps,cmd_vy_mps,plan_tracking_cost,plan_collision_cost,plan_barrier_cost\n"),
-      std::string::npos)
+  EXPECT_NE(csv.find(",cmd_vx_mps,cmd_vy_mps,plan_tracking_cost,plan_collision_cost,"
+                     "plan_barrier_cost,cmd_wz_radps,person_est_theta_rad,"
+                     "person_est_yaw_rate_radps\n"),
+            std::string::npos)
       << csv;
-  EXPECT_NE(csv.find(",0.750,-0.250,12.5,3000.0,0.0\n"), std::string::npos) << csv;
-  EXPECT_NE(csv.find(",0.750,-0.250,nan,nan,nan\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",0.750,-0.250,12.5,3000.0,0.0,0.5000,1.2500,-0.1250\n"), std::string::npos)
+      << csv;
+  EXPECT_NE(csv.find(",0.750,-0.250,nan,nan,nan,0.5000,nan,nan\n"), std::string::npos) << csv;
+}
+
+TEST(RunMetrics, SamplesAreTakenAtTheConfiguredPeriod) {
+  sim::MetricsConfig cfg;
+  cfg.sample_period_s = 0.01;
+  sim::RunMetricsRecorder r(cfg);
+  for (int i = 0; i < 200; ++i) {  // one second of 5 ms world steps
+    r.record(0.005 * i, 0.005, Pose2{-1, 0, 0}, Pose2{0, 0, 0}, {}, 5.0, 1.0, sim::DaemonView{});
+  }
+  ASSERT_EQ(r.samples().size(), 100U);
+  EXPECT_NEAR(r.samples()[1].t_s - r.samples()[0].t_s, 0.01, 1e-9);
 }
 
 TEST(RunReport, WorldCsvListsEveryWallAndObstacleForThePlots) {

@@ -20,7 +20,7 @@
 
 namespace sim {
 
-struct RunSample {  // for pictures: every 100 ms
+struct RunSample {  // for pictures and diagnosis: every MetricsConfig::sample_period_s
   double t_s = 0;
   core::Pose2 robot;   // world
   core::Pose2 person;  // world
@@ -32,6 +32,9 @@ struct RunSample {  // for pictures: every 100 ms
   double cmd_vx_mps = 0, cmd_vy_mps = 0;  // the daemon's last command, base_link
   // The controller's best rollout by cost term (NaN when it is not tracking): why it left q^d.
   double plan_tracking = 0, plan_collision = 0, plan_barrier = 0;
+  double cmd_wz_radps = 0;  // the daemon's last command's turn rate
+  // The daemon's person filter (odom frame; NaN without a track): how late it sees a turn.
+  double person_est_theta_rad = 0, person_est_yaw_rate_radps = 0;
 };
 
 // What failed a run first: the tables count these.
@@ -78,7 +81,9 @@ struct DaemonView {
   // and the age of its last selection.
   core::Pose2 goal_in_person;
   int side = -1;
-  double cmd_vx = 0, cmd_vy = 0;
+  double cmd_vx = 0, cmd_vy = 0, cmd_wz = 0;
+  bool has_person_estimate = false;  // the person filter's heading and turn rate (odom)
+  double person_est_theta = 0, person_est_yaw_rate = 0;
   bool tracking = false;  // the controller ran on q^d: plan_* hold its best rollout's terms
   double plan_tracking = 0, plan_collision = 0, plan_barrier = 0;
 };

@@ -37,6 +37,7 @@ struct SimRunOptions {
   bool person_avoids_robot = true;   // SimWorldConfig::person_avoids_robot
   bool replayed_avoid_robot = true;  // SimWorldConfig::replayed_avoid_robot
   double person_sway_rad = 0;        // SimWorldConfig::person_sway_rad
+  double sample_period_s = 0.1;      // SimRunResult::samples (world steps are 5 ms)
   // The daemon's costmap at these times (s), written as map_server maps STEM-t<time>.pgm/.yaml
   // with what the daemon knew then (sim/costmap_snapshot.hpp): to see why a trial went wrong.
   std::vector<double> costmap_at_s;
