@@ -386,7 +386,12 @@ std::vector<FieldSpec> build() {
        {}},
       {"human.use_gyro",
        "bool",
-       "Also update the person's turn rate from the worn sensor's gyro.",
+       "Also update the person's turn rate from the worn sensor's gyro (its IMU, in every 0x1A "
+       "frame): the filter knows a turn from its first frame, where from the headings alone it "
+       "follows ~0.1 s late. Taken unless above 10 rad/s (not chi-square gated: a gyro is blind "
+       "to the field's distortion, and a sharp corner's first frames are far from the filter's "
+       "rate). Measured with human.prediction_turn_time_constant_s 0.5 (a rate known at once and "
+       "carried 2 s swings q^d far round the person): docs/EVALUATION.md, thirty-ninth session.",
        FIELD(human.use_gyro),
        0,
        0,
