@@ -641,40 +641,6 @@ TEST(SimVlp16, PeopleAreCylindersThatLowBeamsHitAndHighBeamsPass) {
 
 // ---- the world: tracker frames the daemon's person frame reads back ---------------------------
 
-TEST(SimWorld, TrackerFramesPlaceThePersonWhereTheWorldHasThem) {
-  hal::SimClock clock;
-  sim::Scenario s;
-  s.name = "t";
-  s.person = sim::walk({{{2.0, 1.0}}, {{2.0, 5.0}, 1.0}}, 0.0);  // walking +y
-  s.robot_start = Pose2{0.5, 0.5, 0.3};
-  sim::SimWorldConfig cfg;
-  cfg.tracker_extrinsics.source_xyz_m = {0.0, 0.0, 0.35};
-  cfg.tracker_extrinsics.source_rpy_rad = {0.0, 0.0, std::numbers::pi};
-  sim::SimWorld world(s, cfg, clock);
-  auto link = world.take_tracker_link();
-  const amfitrack::PersonFrame frame(cfg.tracker_extrinsics);
-  world.step(0ms);
-  world.step(500ms);
-  int frames = 0;
-  while (auto p = link->receive()) {
-    const auto parsed = amfitrack::decode_payload(*p);
-    if (!parsed.payload) continue;
-    const auto* m = std::get_if<amfitrack::SensorMeasurement>(&*parsed.payload);
-    if (m == nullptr) continue;
-    const auto person = frame.to_base(*m);
-    ASSERT_TRUE(person);
-    ++frames;
-    if (frames == 55) {  // ~0.46 s
-      const Pose2 truth = world.robot_pose().inverse() * world.person_pose();
-      EXPECT_NEAR(person->x_m, truth.x_m, 0.05);
-      EXPECT_NEAR(person->y_m, truth.y_m, 0.05);
-      EXPECT_NEAR(person->z_m, 1.0, 1e-3);
-      EXPECT_NEAR(core::wrap_angle(person->heading_rad - truth.theta_rad), 0.0, 1e-3);
-    }
-  }
-  EXPECT_NEAR(frames, 60, 1) << "120 Hz";
-}
-
 namespace {
 // Every tracker frame of a world run for `ms` with the robot standing, read back through the
 // real decoder and person frame, with the world's truth (base_link) when it was sent.
@@ -722,6 +688,24 @@ sim::Scenario circle_walker(double cx, double cy, double radius_m, double speed_
   return s;
 }
 }  // namespace
+
+TEST(SimWorld, TrackerFramesPlaceThePersonWhereTheWorldHasThem) {
+  sim::Scenario s;
+  s.name = "t";
+  s.person = sim::walk({{{2.0, 1.0}}, {{2.0, 5.0}, 1.0}}, 0.0);  // walking +y
+  s.robot_start = Pose2{0.5, 0.5, 0.3};
+  sim::SimWorldConfig cfg;
+  cfg.tracker_extrinsics.source_xyz_m = {0.0, 0.0, 0.35};
+  cfg.tracker_extrinsics.source_rpy_rad = {0.0, 0.0, std::numbers::pi};
+  const auto frames = read_back_tracker(s, cfg, 500);
+  EXPECT_NEAR(static_cast<double>(frames.size()), 60, 1) << "120 Hz, every frame a pose";
+  ASSERT_GT(frames.size(), 55U);
+  const ReadBack& f = frames[54];  // ~0.46 s
+  EXPECT_NEAR(f.person.x_m, f.truth.x_m, 0.05);
+  EXPECT_NEAR(f.person.y_m, f.truth.y_m, 0.05);
+  EXPECT_NEAR(f.person.z_m, 1.0, 1e-3);
+  EXPECT_NEAR(core::wrap_angle(f.person.heading_rad - f.truth.theta_rad), 0.0, 1e-3);
+}
 
 TEST(SimWorld, TheWornSensorsGyroReadsThePersonsTurnRateInItsOwnAxes) {
   // 1 m/s round a 2 m circle: 0.5 rad/s. The sensor is worn on its side (rolled 90 degrees), so
