@@ -238,12 +238,8 @@ void SimWorld::advance(double t_s) {
   const double dt = t_s - t_s_;
   move_person(t_s, dt);
   if (dt > 0) {
-    person_yaw_rate_radps_ = scenario_.person.turn_rate_at(t_s);
-    sway_phase_rate_radps_ = 2.0 * std::numbers::pi *
-                             std::hypot(person_velocity_.x_m, person_velocity_.y_m) /
-                             config_.person_stride_m;
     sway_phase_rad_ =
-        std::fmod(sway_phase_rad_ + sway_phase_rate_radps_ * dt, 2.0 * std::numbers::pi);
+        std::fmod(sway_phase_rad_ + sway_phase_rate_radps() * dt, 2.0 * std::numbers::pi);
   }
   move_replayed(t_s, dt);
   if (dt > 0) {
@@ -261,6 +257,11 @@ void SimWorld::advance(double t_s) {
   t_s_ = t_s;
 }
 
+double SimWorld::sway_phase_rate_radps() const {
+  return 2.0 * std::numbers::pi * std::hypot(person_velocity_.x_m, person_velocity_.y_m) /
+         config_.person_stride_m;
+}
+
 void SimWorld::update_tracker_pose() {
   // The person in base_link, then in the source's frame: what the sensor reports.
   const core::Pose2 rel = robot_pose().inverse() * person_;
@@ -274,9 +275,9 @@ void SimWorld::update_tracker_pose() {
                            {q.x(), q.y(), q.z(), q.w()});
   // The gyro: the torso turns about the vertical at the walking heading's rate plus the sway's,
   // whatever the robot does (a gyro is inertial); in the sensor's own axes.
-  const double body_rate_radps = person_yaw_rate_radps_ + config_.person_sway_rad *
-                                                              std::cos(sway_phase_rad_) *
-                                                              sway_phase_rate_radps_;
+  const double body_rate_radps =
+      scenario_.person.turn_rate_at(t_s_) +
+      config_.person_sway_rad * std::cos(sway_phase_rad_) * sway_phase_rate_radps();
   const Eigen::Vector3d gyro_dps =
       r_body_sensor_.transpose() *
       Eigen::Vector3d(0, 0, body_rate_radps * 180.0 / std::numbers::pi);

@@ -7,14 +7,19 @@
 
 namespace sim {
 
+size_t Trajectory::step_at(double t_s) const {
+  const auto it = std::upper_bound(samples_.begin(), samples_.end(), t_s,
+                                   [](double t, const TimedPose& s) { return t < s.t_s; });
+  return static_cast<size_t>(it - samples_.begin()) - 1;
+}
+
 core::Pose2 Trajectory::pose_at(double t_s) const {
   if (samples_.empty()) return {};
   if (t_s <= samples_.front().t_s) return samples_.front().pose;
   if (t_s >= samples_.back().t_s) return samples_.back().pose;
-  const auto it = std::upper_bound(samples_.begin(), samples_.end(), t_s,
-                                   [](double t, const TimedPose& s) { return t < s.t_s; });
-  const TimedPose& b = *it;
-  const TimedPose& a = *(it - 1);
+  const size_t i = step_at(t_s);
+  const TimedPose& a = samples_[i];
+  const TimedPose& b = samples_[i + 1];
   const double span = b.t_s - a.t_s;
   const double s = span > 0 ? (t_s - a.t_s) / span : 1.0;
   core::Pose2 p = core::interpolate(a.pose, b.pose, s);
@@ -24,10 +29,9 @@ core::Pose2 Trajectory::pose_at(double t_s) const {
 
 core::Point2 Trajectory::velocity_at(double t_s) const {
   if (samples_.size() < 2 || t_s < samples_.front().t_s || t_s >= samples_.back().t_s) return {};
-  const auto it = std::upper_bound(samples_.begin(), samples_.end(), t_s,
-                                   [](double t, const TimedPose& s) { return t < s.t_s; });
-  const TimedPose& b = *it;
-  const TimedPose& a = *(it - 1);
+  const size_t i = step_at(t_s);
+  const TimedPose& a = samples_[i];
+  const TimedPose& b = samples_[i + 1];
   const double span = b.t_s - a.t_s;
   if (span <= 0) return {};
   return {(b.pose.x_m - a.pose.x_m) / span, (b.pose.y_m - a.pose.y_m) / span};
@@ -35,10 +39,9 @@ core::Point2 Trajectory::velocity_at(double t_s) const {
 
 double Trajectory::turn_rate_at(double t_s) const {
   if (samples_.size() < 2 || t_s < samples_.front().t_s || t_s >= samples_.back().t_s) return 0;
-  const auto it = std::upper_bound(samples_.begin(), samples_.end(), t_s,
-                                   [](double t, const TimedPose& s) { return t < s.t_s; });
-  const TimedPose& b = *it;
-  const TimedPose& a = *(it - 1);
+  const size_t i = step_at(t_s);
+  const TimedPose& a = samples_[i];
+  const TimedPose& b = samples_[i + 1];
   const double span = b.t_s - a.t_s;
   if (span <= 0) return 0;
   return core::wrap_angle(b.pose.theta_rad - a.pose.theta_rad) / span;

@@ -839,43 +839,41 @@ TEST(SimWorld, ThePersonDoesNotWalkIntoAStandingRobotButPastItAndBackOntoTheirPa
       << "the scripted walk alone goes through the robot";
 }
 
-TEST(SimWorld, ARecordedPedestrianDoesNotWalkIntoAStandingRobotEither) {
-  // A recorded pedestrian whose recording goes straight through where the robot stands; the
-  // followed person is far away. They walk round it, as a person does, and back onto their
-  // recording; only with replayed_avoid_robot off (the old replay) do they walk through it.
+namespace {
+// A recorded pedestrian `recording` beside the standing robot (the followed person far away),
+// until `until_ms`: with replayed_avoid_robot (the default) they keep the contact margin and end
+// at `end`, back on their recording; without it the recording alone touches the robot.
+void expect_recorded_walker_clears_standing_robot(const sim::Trajectory& recording, int until_ms,
+                                                  Point2 end) {
   sim::Scenario s;
   s.name = "t";
   s.person = sim::walk({{{0.0, 10.0}}, {{5.0, 10.0}, 1.0}}, 0.0);
-  s.replayed.push_back(sim::walk({{{0.0, 0.0}}, {{5.0, 0.0}, 1.0, 4.0}}, 0.0));
+  s.replayed.push_back(recording);
   s.robot_start = Pose2{2.0, 0.0, 0.0};
   sim::SimWorldConfig cfg;
-  const StandingRobotRun avoid = run_beside_standing_robot(s, cfg, 8500);  // ends at 9 s
+  const StandingRobotRun avoid = run_beside_standing_robot(s, cfg, until_ms);
   EXPECT_GT(avoid.least_clearance_m, 0.04) << "kept the contact margin (0.05 m)";
   ASSERT_EQ(avoid.pedestrians.size(), 1U);
-  EXPECT_NEAR(avoid.pedestrians[0].x_m, 5.0, 0.02) << "back on the recording's end point";
-  EXPECT_NEAR(avoid.pedestrians[0].y_m, 0.0, 0.02);
+  EXPECT_NEAR(avoid.pedestrians[0].x_m, end.x_m, 0.02) << "back on the recording";
+  EXPECT_NEAR(avoid.pedestrians[0].y_m, end.y_m, 0.02);
   cfg.replayed_avoid_robot = false;
-  EXPECT_EQ(run_beside_standing_robot(s, cfg, 8500).least_clearance_m, 0.0)
-      << "the recording alone goes through the robot";
+  EXPECT_EQ(run_beside_standing_robot(s, cfg, until_ms).least_clearance_m, 0.0)
+      << "the recording alone touches the robot";
+}
+}  // namespace
+
+TEST(SimWorld, ARecordedPedestrianDoesNotWalkIntoAStandingRobotEither) {
+  // A recording straight through where the robot stands: they walk round it, as a person does,
+  // and back onto their recording's end (only the old replay walks through it).
+  expect_recorded_walker_clears_standing_robot(
+      sim::walk({{{0.0, 0.0}}, {{5.0, 0.0}, 1.0, 4.0}}, 0.0), 8500, {5.0, 0.0});  // ends at 9 s
 }
 
 TEST(SimWorld, ARecordedPedestrianFirstSeenWhereTheRobotStandsAppearsClearOfIt) {
   // The recording starts at 1 s inside the standing robot's footprint (a person entering the
-  // camera's view there). They appear just clear of it and walk back onto their recording.
-  sim::Scenario s;
-  s.name = "t";
-  s.person = sim::walk({{{0.0, 10.0}}, {{5.0, 10.0}, 1.0}}, 0.0);
-  s.replayed.push_back(sim::walk({{{2.1, 0.1}}, {{2.1, 4.0}, 1.0, 2.0}}, 1.0));
-  s.robot_start = Pose2{2.0, 0.0, 0.0};
-  sim::SimWorldConfig cfg;
-  const StandingRobotRun avoid = run_beside_standing_robot(s, cfg, 6000);  // ends at 6.9 s
-  EXPECT_GT(avoid.least_clearance_m, 0.04) << "appeared keeping the contact margin (0.05 m)";
-  ASSERT_EQ(avoid.pedestrians.size(), 1U);
-  EXPECT_NEAR(avoid.pedestrians[0].x_m, 2.1, 0.02) << "back on the recording";
-  EXPECT_NEAR(avoid.pedestrians[0].y_m, 4.0, 0.02);
-  cfg.replayed_avoid_robot = false;
-  EXPECT_EQ(run_beside_standing_robot(s, cfg, 6000).least_clearance_m, 0.0)
-      << "the recording alone starts inside the robot";
+  // camera's view there): they appear just clear of it and walk back onto their recording.
+  expect_recorded_walker_clears_standing_robot(
+      sim::walk({{{2.1, 0.1}}, {{2.1, 4.0}, 1.0, 2.0}}, 1.0), 6000, {2.1, 4.0});  // ends at 6.9 s
 }
 
 // ---- the in-process datagram link ---------------------------------------------------------------

@@ -121,6 +121,7 @@ class SimWorld {
   // where a recorded pedestrian first seen at the robot is (they walked round it unseen, and
   // return to their recording as from any detour).
   [[nodiscard]] Point2 clear_of_robot(Point2 p, double radius_m) const;
+  [[nodiscard]] double sway_phase_rate_radps() const;  // 2 pi per stride at the person's pace
   void update_tracker_pose();
   [[nodiscard]] double footprint_distance(const Point2& p) const;  // point to footprint (world)
   [[nodiscard]] core::Pose2 robot_at(hal::Nanos t) const;
@@ -140,9 +141,7 @@ class SimWorld {
   Eigen::Matrix3d r_base_source_;
   Eigen::Vector3d t_base_source_;
   Eigen::Matrix3d r_body_sensor_;
-  double person_yaw_rate_radps_ = 0;  // of the walking heading (Trajectory::turn_rate_at)
-  double sway_phase_rad_ = 0;
-  double sway_phase_rate_radps_ = 0;
+  double sway_phase_rad_ = 0;  // SimWorldConfig::person_sway_rad's, advanced by distance walked
 
   bool lidar_silent_ = false;
   bool started_ = false;

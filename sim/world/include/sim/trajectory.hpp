@@ -30,6 +30,10 @@ class Trajectory {
   [[nodiscard]] const std::vector<TimedPose>& samples() const { return samples_; }
 
  private:
+  // The sample step [i, i + 1] that holds t_s (samples_[i].t_s <= t_s < samples_[i + 1].t_s);
+  // for t_s within [first, last) only.
+  [[nodiscard]] size_t step_at(double t_s) const;
+
   std::vector<TimedPose> samples_;
 };
 
