@@ -94,54 +94,20 @@ HumanTrack predict_track(const HumanTrack& track, Nanos t, const HumanEkfConfig&
   return out;
 }
 
-namespace {
-// Seconds of motion at the current rate that the prediction amounts to by t (the integral of
-// exp(-t / tau)); before the stamp the track's own constant-rate model.
-double faded(double t_s, double tau_s) {
-  return tau_s > 0.0 && t_s > 0.0 ? tau_s * -std::expm1(-t_s / tau_s) : t_s;
-}
-}  // namespace
-
 void predict_path(const HumanTrack& track, Nanos t0, double dt_s, double time_constant_s,
                   double turn_time_constant_s, std::span<Pose2> out) {
   const double t0_s = to_seconds(t0 - track.stamp);
+  // Seconds of motion at the current rate that the prediction amounts to by t (the integral of
+  // exp(-t / tau)); before the stamp the track's own constant-rate model.
+  const auto faded = [](double t, double tau) {
+    return tau > 0.0 && t > 0.0 ? tau * -std::expm1(-t / tau) : t;
+  };
   for (size_t k = 0; k < out.size(); ++k) {
     const double t = t0_s + dt_s * static_cast<double>(k);
     const double s = faded(t, time_constant_s);
     const double s_turn = faded(t, turn_time_constant_s);
     out[k] = Pose2{track.mean()(0) + track.mean()(3) * s, track.mean()(1) + track.mean()(4) * s,
                    wrap_angle(track.mean()(2) + track.mean()(5) * s_turn)};
-  }
-}
-
-void predict_arc_path(const HumanTrack& track, Nanos t0, double dt_s, double time_constant_s,
-                      double turn_time_constant_s, std::span<Pose2> out) {
-  const double vx = track.mean()(3);
-  const double vy = track.mean()(4);
-  const double theta0 = track.mean()(2);
-  const double omega = track.mean()(5);
-  // The velocity turned by the heading's predicted change phi(t), integrated segment by segment:
-  // the chord of each segment's arc (along the mid angle, sin(d/2) / (d/2) of the arc's length),
-  // exact while the heading turns in proportion to the distance walked (no fading).
-  double x = track.mean()(0);
-  double y = track.mean()(1);
-  double s_prev = 0.0;
-  double phi_prev = 0.0;
-  const double t0_s = to_seconds(t0 - track.stamp);
-  for (size_t k = 0; k < out.size(); ++k) {
-    const double t = t0_s + dt_s * static_cast<double>(k);
-    const double s = faded(t, time_constant_s);
-    const double phi = omega * faded(t, turn_time_constant_s);
-    const double mid = 0.5 * (phi_prev + phi);
-    const double half_turn = 0.5 * (phi - phi_prev);
-    const double chord = std::abs(half_turn) > 1e-9 ? std::sin(half_turn) / half_turn
-                                                    : 1.0 - half_turn * half_turn / 6;
-    const double ds = (s - s_prev) * chord;
-    x += (std::cos(mid) * vx - std::sin(mid) * vy) * ds;
-    y += (std::sin(mid) * vx + std::cos(mid) * vy) * ds;
-    out[k] = Pose2{x, y, wrap_angle(theta0 + phi)};
-    s_prev = s;
-    phi_prev = phi;
   }
 }
 
@@ -160,13 +126,8 @@ void predict_person_and_goal_paths(const HumanTrack& track, Nanos t0, double dt_
   // by rounding: the margin keeps it beside.)
   constexpr double kAheadM = 0.05;
   const bool leading = goal_in_person.x_m > kAheadM;
-  if (!leading && (tau_s > 0.0 || turn_s > 0.0 || config.prediction_arc)) {
-    const double goal_turn_s = turn_s > 0.0 ? turn_s : tau_s;
-    if (config.prediction_arc) {
-      predict_arc_path(track, t0, dt_s, tau_s, goal_turn_s, goal);
-    } else {
-      predict_path(track, t0, dt_s, tau_s, goal_turn_s, goal);
-    }
+  if (!leading && (tau_s > 0.0 || turn_s > 0.0)) {
+    predict_path(track, t0, dt_s, tau_s, turn_s > 0.0 ? turn_s : tau_s, goal);
   } else {  // nothing fades: the barrier's prediction, without a second pass
     std::copy_n(person.begin(), std::min(person.size(), goal.size()), goal.begin());
   }

@@ -444,16 +444,6 @@ std::vector<FieldSpec> build() {
        0.0,
        60.0,
        {}},
-      {"human.prediction_arc",
-       "bool",
-       "In that prediction, q^d's carrier person walks the arc of their turn (the velocity turns "
-       "with the heading) instead of walking straight on while facing round. The barrier's "
-       "person keeps a constant velocity either way. Measured: docs/EVALUATION.md, fortieth "
-       "session.",
-       FIELD(human.prediction_arc),
-       0,
-       0,
-       {}},
       {"human.gate_probability",
        "-",
        "Chi-square gate of the filter: a pose outside this probability mass is an outlier (0.99, "

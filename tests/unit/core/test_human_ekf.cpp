@@ -338,64 +338,6 @@ TEST(HumanEkf, TheTurnRateFadesWithItsOwnTimeConstant) {
   }
 }
 
-// A person turning at a constant rate walks a circle of radius v / omega; the arc prediction
-// puts them on it, where predict_path walks them straight on facing round. Faded, the arc keeps
-// the faded path's length and heading.
-TEST(HumanEkf, TheArcPredictionWalksTheTurnsCircle) {
-  core::HumanTrack track;
-  track.valid = true;
-  track.mean() << 1.0, 2.0, std::numbers::pi / 2, 0.0, 1.2,
-      1.0;  // walking 1.2 m/s along +y, turning 1 rad/s
-  track.stamp = 1s;
-  std::array<Pose2, 31> arc{};
-  std::array<Pose2, 31> straight{};
-  core::predict_arc_path(track, 1s, 0.1, 0.0, 0.0, arc);
-  core::predict_path(track, 1s, 0.1, 0.0, 0.0, straight);
-  const double r_m = 1.2 / 1.0;
-  const core::Point2 centre{1.0 - r_m, 2.0};  // turning left from heading +y: the centre is at -x
-  for (size_t k = 0; k < arc.size(); ++k) {
-    const double t_s = 0.1 * static_cast<double>(k);
-    EXPECT_NEAR(std::hypot(arc[k].x_m - centre.x_m, arc[k].y_m - centre.y_m), r_m, 1e-9)
-        << "on the circle at " << t_s << " s";
-    EXPECT_NEAR(arc[k].theta_rad, straight[k].theta_rad, 1e-12) << "the same heading";
-  }
-  // A quarter turn (pi/2 s): a quarter round the circle, at (1 - r, 2 + r).
-  std::array<Pose2, 1> quarter{};
-  const Nanos quarter_turn{static_cast<int64_t>(std::numbers::pi / 2 * 1e9)};
-  core::predict_arc_path(track, 1s + quarter_turn, 0.1, 0.0, 0.0, quarter);
-  EXPECT_NEAR(quarter[0].x_m, 1.0 - r_m, 1e-6) << "one segment from the stamp: the chord is exact";
-  EXPECT_NEAR(quarter[0].y_m, 2.0 + r_m, 1e-6);
-  EXPECT_NEAR(straight[30].y_m, 2.0 + 1.2 * 3.0, 1e-9) << "predict_path walks straight on";
-  // Faded (tau 2 s, turn 0.5 s): as far along as predict_path's faded path, turned as far.
-  std::array<Pose2, 101> arc_faded{};
-  std::array<Pose2, 101> straight_faded{};
-  core::predict_arc_path(track, 1s, 0.1, 2.0, 0.5, arc_faded);
-  core::predict_path(track, 1s, 0.1, 2.0, 0.5, straight_faded);
-  double length_m = 0.0;
-  for (size_t k = 1; k < arc_faded.size(); ++k) {
-    length_m += std::hypot(arc_faded[k].x_m - arc_faded[k - 1].x_m,
-                           arc_faded[k].y_m - arc_faded[k - 1].y_m);
-    EXPECT_NEAR(arc_faded[k].theta_rad, straight_faded[k].theta_rad, 1e-12);
-  }
-  // (The chords of the arc, a little shorter than the arc walked.)
-  EXPECT_NEAR(length_m, straight_faded[100].y_m - 2.0, 5e-3) << "the same distance walked";
-  EXPECT_LT(length_m, straight_faded[100].y_m - 2.0);
-  EXPECT_LT(arc_faded[100].x_m, 1.0 - 0.3) << "bent left by the half radian turned";
-  // The controller's q^d carrier walks the arc with prediction_arc; the barrier's person does not.
-  core::HumanEkfConfig c;
-  c.prediction_time_constant_s = 2.0;
-  c.prediction_turn_time_constant_s = 0.5;
-  c.prediction_arc = true;
-  std::array<Pose2, 101> person{};
-  std::array<Pose2, 101> goal{};
-  core::predict_person_and_goal_paths(track, 1s, 0.1, c, Pose2{}, person, goal);
-  for (size_t k = 0; k < goal.size(); ++k) {
-    EXPECT_DOUBLE_EQ(goal[k].x_m, arc_faded[k].x_m);
-    EXPECT_DOUBLE_EQ(goal[k].y_m, arc_faded[k].y_m);
-    EXPECT_DOUBLE_EQ(person[k].x_m, straight[0].x_m) << "constant velocity along +y";
-  }
-}
-
 // One rule for the daemon's controller and the evaluation's snapshots: the barrier's person at
 // constant velocity and turn rate, q^d's carrier faded, turning as
 // prediction_turn_time_constant_s says (random seed 112 of docs/EVALUATION.md: a person turning

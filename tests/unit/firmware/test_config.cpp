@@ -282,16 +282,6 @@ TEST(Config, ThePredictedTurnRateTimeConstantReachesTheFilterConfig) {
       load_config_text("human:\n  prediction_turn_time_constant_s: -1\n", "test.yaml").ok());
 }
 
-TEST(Config, TheArcPredictionReachesTheFilterConfig) {
-  const auto set = load_config_text("human:\n  prediction_arc: true\n", "test.yaml");
-  ASSERT_TRUE(set.ok()) << set.errors[0].to_string();
-  EXPECT_TRUE(firmware::human_ekf_config(*set.config).prediction_arc);
-  const auto off = load_config_text("human:\n  prediction_arc: false\n", "test.yaml");
-  ASSERT_TRUE(off.ok()) << off.errors[0].to_string();
-  EXPECT_FALSE(firmware::human_ekf_config(*off.config).prediction_arc);
-  EXPECT_FALSE(load_config_text("human:\n  prediction_arc: 2\n", "test.yaml").ok());
-}
-
 TEST(Config, TheTrackingFrameIsAChoiceThatReachesTheController) {
   expect_error(load_config_text("mppi:\n  tracking_frame: odom\n", "test.yaml"), 2,
                "mppi.tracking_frame", "not one of");

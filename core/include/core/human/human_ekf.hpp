@@ -38,9 +38,6 @@ struct HumanEkfConfig {
   // The same for the person's turn rate (0: as the velocity: prediction_time_constant_s for
   // q^d's path, constant for the barrier's person). See predict_path.
   double prediction_turn_time_constant_s = 0.0;
-  // q^d's carrier person walks the arc of its turn (its velocity turns with its heading:
-  // predict_arc_path) instead of walking straight on while its heading turns (predict_path).
-  bool prediction_arc = false;
 };
 
 using HumanVector = Eigen::Matrix<double, 6, 1>;
@@ -113,11 +110,6 @@ HumanTrack predict_track(const HumanTrack& track, Nanos t, const HumanEkfConfig&
 // predicted person round and round: a person's turn lasts about a second.
 void predict_path(const HumanTrack& track, Nanos t0, double dt_s, double time_constant_s,
                   double turn_time_constant_s, std::span<Pose2> out);
-// As predict_path, but the velocity turns with the predicted heading: the person walks the arc
-// their turn rate makes (a coordinated turn) rather than straight on facing round. At constant
-// turn rate and speed, a circle of radius |v| / omega.
-void predict_arc_path(const HumanTrack& track, Nanos t0, double dt_s, double time_constant_s,
-                      double turn_time_constant_s, std::span<Pose2> out);
 // What the controller predicts over its horizon, one rule for every caller: `person`, for the
 // barrier, at constant velocity and turn rate (the conservative place they may be); `goal`, q^d's
 // path: the chosen point held in the frame of a carrier person whose velocity fades as
