@@ -391,7 +391,8 @@ std::vector<FieldSpec> build() {
        "follows ~0.1 s late. Taken unless above 10 rad/s (not chi-square gated: a gyro is blind "
        "to the field's distortion, and a sharp corner's first frames are far from the filter's "
        "rate). Measured with human.prediction_turn_time_constant_s 0.5 (a rate known at once and "
-       "carried 2 s swings q^d far round the person): docs/EVALUATION.md, thirty-ninth session.",
+       "carried 2 s swings q^d far round the person): e_theta lower on every random table, but "
+       "more trials lost in crowds (docs/EVALUATION.md, thirty-ninth and fortieth sessions).",
        FIELD(human.use_gyro),
        0,
        0,
