@@ -260,6 +260,7 @@ TEST(Scenario, CrossingPedestriansAreTimedToPassJustBehindThePerson) {
 TEST(Walk, HeadingIsKeptWhileStanding) {
   // Recorded positions jitter by a centimetre while a person stands: no spinning heading.
   std::vector<sim::TimedPose> s;
+  s.reserve(20);
   for (int i = 0; i < 10; ++i)
     s.push_back({0.4 * i, {0.4 * i, 0.0, 0.0}});  // walking +x at 1 m/s
   for (int i = 10; i < 20; ++i)
@@ -601,9 +602,10 @@ TEST(SimVlp16, AWallAheadDecodesAtItsDistanceAndTheGroundBelowTheSensor) {
       if (x < -0.5 && std::abs(y) < 1.0) ++behind;
     }
   };
-  for (int ms = 5; ms <= 200; ms += 5)
+  for (int ms = 5; ms <= 200; ms += 5) {
     lidar.step(
         hal::Nanos(std::chrono::milliseconds(ms)), w, {}, [](hal::Nanos) { return Pose2{}; }, sink);
+  }
   EXPECT_GT(wall, 100);
   EXPECT_GT(ground, 100);
   EXPECT_GT(behind, 0) << "only ground behind";
@@ -631,10 +633,11 @@ TEST(SimVlp16, PeopleAreCylindersThatLowBeamsHitAndHighBeamsPass) {
       }
     }
   };
-  for (int ms = 5; ms <= 100; ms += 5)
+  for (int ms = 5; ms <= 100; ms += 5) {
     lidar.step(
         hal::Nanos(std::chrono::milliseconds(ms)), empty, person,
         [](hal::Nanos) { return Pose2{}; }, sink);
+  }
   EXPECT_GT(hits, 20);
   EXPECT_LE(max_z, 1.0 - 0.45 + 0.01) << "nothing above the person's head";
 }
