@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """How sharply people turn: recorded pedestrians against the simulated person's walks.
 
-    sim/eval/turn_stats.py [--period-s 0.4] [--walking-mps 0.5] [--window-s 2] SOURCE...
+    sim/eval/turn_stats.py [--period-s 0.4] [--walking-mps 0.5] [--window-s 2] [--acf-lags N]
+                           SOURCE...
 
 A SOURCE is a recorded-pedestrian file (`frame id x y`, the format of sim/data/pedestrians/, one
 frame step taken as --period-s; every person's track, split where they are not observed for a
@@ -16,7 +17,11 @@ read alike, which is the point of the comparison.
 Prints a Markdown table, one row per source: the walking time, the median speed, the heading
 rate's p50 / p90 / p99 and the share of the time above 0.5 and 1 rad/s, and the heading change
 over the --window-s windows walked all through (p50 / p90 / p99, the share above 45 and 90
-degrees). Standard library only.
+degrees). With --acf-lags N, a second table: the signed heading rate's autocorrelation (about
+zero) at 1..N periods, over the pairs of rates walked all through, and the time constant tau of
+a rate that fades as exp(-t / tau) read at the first lag whose two rates share no position (four
+periods): how long a turn goes on, which is what a prediction of the person's turn should fade
+with (human.prediction_turn_time_constant_s). Standard library only.
 """
 import argparse
 import collections
@@ -73,16 +78,22 @@ def read_samples(path, period_s):
     return track
 
 
+def headings_of(track, period_s):
+    """(heading rad, speed m/s) at every inner sample of a track: central differences."""
+    headings = []
+    for k in range(1, len(track) - 1):
+        vx = (track[k + 1][0] - track[k - 1][0]) / (2 * period_s)
+        vy = (track[k + 1][1] - track[k - 1][1]) / (2 * period_s)
+        headings.append((math.atan2(vy, vx), math.hypot(vx, vy)))
+    return headings
+
+
 def turn_statistics(tracks, period_s, walking_mps, window_s):
     """Heading rates (rad/s) and window turns (rad) of tracks sampled every period_s."""
     rates, turns, speeds = [], [], []
     window = max(1, round(window_s / period_s))
     for track in tracks:
-        headings = []  # (heading, speed) at every inner sample
-        for k in range(1, len(track) - 1):
-            vx = (track[k + 1][0] - track[k - 1][0]) / (2 * period_s)
-            vy = (track[k + 1][1] - track[k - 1][1]) / (2 * period_s)
-            headings.append((math.atan2(vy, vx), math.hypot(vx, vy)))
+        headings = headings_of(track, period_s)
         walking = [speed > walking_mps for _, speed in headings]
         for k in range(len(headings) - 1):
             if walking[k] and walking[k + 1]:
@@ -92,6 +103,51 @@ def turn_statistics(tracks, period_s, walking_mps, window_s):
             if all(walking[k:k + window + 1]):
                 turns.append(abs(eval_samples.wrap(headings[k + window][0] - headings[k][0])))
     return rates, turns, speeds
+
+
+# A heading rate spans four positions (two central differences), so rates this many periods apart
+# share none: their correlation is the walker's, not the positions' noise made into both.
+FIRST_INDEPENDENT_LAG = 4
+
+
+def rate_autocorrelation(tracks, period_s, walking_mps, max_lag):
+    """The signed heading rate's correlation about zero at lags 0..max_lag periods, over the
+    pairs of rates walked all through: [(pairs, mean r_k r_k+m / mean r_k^2 over those pairs)].
+    How long a turn goes on: a rate that fades as exp(-t / tau) keeps exp(-m period / tau)."""
+    products = [[0.0, 0.0, 0] for _ in range(max_lag + 1)]  # sum r_k r_k+m, sum r_k^2, pairs
+    for track in tracks:
+        headings = headings_of(track, period_s)
+        rates = [eval_samples.wrap(b[0] - a[0]) / period_s
+                 if a[1] > walking_mps and b[1] > walking_mps else None
+                 for a, b in zip(headings, headings[1:])]
+        for m, p in enumerate(products):
+            for a, b in zip(rates, rates[m:]):
+                if a is not None and b is not None:
+                    p[0] += a * b
+                    p[1] += a * a
+                    p[2] += 1
+    return [(n, s / s2 if s2 > 0 else math.nan) for s, s2, n in products]
+
+
+def fade_time_constant(correlation, lag_s):
+    """tau of exp(-lag / tau) = correlation: inf when the rate keeps (>= 1), 0 when it is gone."""
+    if math.isnan(correlation):
+        return math.nan
+    if correlation >= 1.0:
+        return math.inf
+    # Below 1e-9 the rate is gone (a correlation of zero sums to +-1e-17, not 0).
+    return -lag_s / math.log(correlation) if correlation > 1e-9 else 0.0
+
+
+def acf_row(label, correlations, period_s):
+    cells = " | ".join("-" if math.isnan(c) else f"{c:.2f}" for _, c in correlations[1:])
+    if len(correlations) > FIRST_INDEPENDENT_LAG:
+        lag_s = FIRST_INDEPENDENT_LAG * period_s
+        tau = fade_time_constant(correlations[FIRST_INDEPENDENT_LAG][1], lag_s)
+        tau_cell = "-" if math.isnan(tau) else f"{tau:.2f}"
+    else:
+        tau_cell = "-"
+    return f"| {label} | {correlations[0][0]} | {cells} | {tau_cell} |"
 
 
 def percentile(values, q):
@@ -137,7 +193,12 @@ def main():
     ap.add_argument("--period-s", type=float, default=0.4)
     ap.add_argument("--walking-mps", type=float, default=0.5)
     ap.add_argument("--window-s", type=float, default=2.0)
+    ap.add_argument("--acf-lags", type=int, default=0,
+                    help="also the heading rate's autocorrelation at 1..N periods (a second "
+                         "table) and the time constant it implies")
     args = ap.parse_args()
+    if args.acf_lags < 0:
+        ap.error(f"--acf-lags must be >= 0, not {args.acf_lags}")
     for name in ("period_s", "walking_mps", "window_s"):
         value = getattr(args, name)
         if not math.isfinite(value) or value < 0 or (name != "walking_mps" and value == 0):
@@ -147,6 +208,7 @@ def main():
           f"> 0.5 rad/s % | > 1 rad/s % | turn in {w} p50 / p90 / p99 deg | "
           f"> 45 deg in {w} % | > 90 deg in {w} % |")
     print("|---|---|---|---|---|---|---|---|---|")
+    acf_rows = []
     for label, kind, files in sources(args.paths):
         if not files:
             sys.exit(f"turn_stats: no sample files in {label}")
@@ -164,7 +226,18 @@ def main():
         if kind == "samples":
             name += f" ({len(files)} trials)"
         print(row(name, *stats, args.period_s))
-
+        if args.acf_lags:
+            correlations = rate_autocorrelation(tracks, args.period_s, args.walking_mps,
+                                                args.acf_lags)
+            acf_rows.append(acf_row(name, correlations, args.period_s))
+    if acf_rows:
+        lags = " | ".join(f"{m * args.period_s:g} s" for m in range(1, args.acf_lags + 1))
+        first = f"{FIRST_INDEPENDENT_LAG * args.period_s:g} s"
+        print()
+        print(f"| source | rate pairs | heading rate's autocorrelation at {lags} | "
+              f"time constant from {first} (no shared positions) s |")
+        print("|---|---|" + "---|" * args.acf_lags + "---|")
+        print("\n".join(acf_rows))
 
 if __name__ == "__main__":
     main()

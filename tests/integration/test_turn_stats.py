@@ -57,6 +57,53 @@ class TurnStatistics(unittest.TestCase):
                                "0 / 60 / 120 | 20.0 | 5.0 |")
 
 
+def zigzag(corners, legs=10, angle=0.5):
+    """Straight legs of `legs` steps, turning by +angle, -angle, ... at the `corners` corners."""
+    out, x, y, th = [], 0.0, 0.0, 0.0
+    for c in range(corners + 1):
+        for _ in range(legs):
+            out.append((x, y))
+            x, y = x + PERIOD * math.cos(th), y + PERIOD * math.sin(th)
+        th += angle if c % 2 == 0 else -angle
+    out.append((x, y))
+    return out
+
+
+class RateAutocorrelation(unittest.TestCase):
+    def test_a_circle_keeps_its_rate_at_every_lag(self):
+        correlations = turn_stats.rate_autocorrelation([arc(40, rate=0.5)], PERIOD, 0.5, 5)
+        self.assertEqual(correlations[0][0], 37)  # 38 inner samples, 37 rates
+        self.assertEqual(correlations[5][0], 32)
+        for _, c in correlations:
+            self.assertAlmostEqual(c, 1.0, places=9)
+        self.assertEqual(turn_stats.fade_time_constant(correlations[4][1], 1.6), math.inf)
+
+    def test_corners_correlate_only_within_a_corner_and_with_the_next(self):
+        # A corner at a vertex reads as two rates of angle / 2 (the central differences either
+        # side of it); the next corner, 10 steps on, turns back.
+        correlations = turn_stats.rate_autocorrelation([zigzag(6)], PERIOD, 0.5, 10)
+        self.assertAlmostEqual(correlations[1][1], 0.5, places=9)
+        for m in range(2, 9):
+            self.assertAlmostEqual(correlations[m][1], 0.0, places=9)
+        self.assertAlmostEqual(correlations[10][1], -1.0, places=9)
+        self.assertEqual(turn_stats.fade_time_constant(correlations[4][1], 1.6), 0.0)
+
+    def test_standing_walkers_and_short_tracks_leave_no_pairs(self):
+        correlations = turn_stats.rate_autocorrelation(
+            [arc(30, speed=0.3, rate=2.0), arc(3)], PERIOD, 0.5, 2)
+        self.assertEqual([n for n, _ in correlations], [0, 0, 0])
+        self.assertTrue(all(math.isnan(c) for _, c in correlations))
+        self.assertTrue(math.isnan(turn_stats.fade_time_constant(math.nan, 1.6)))
+
+    def test_the_time_constant_is_read_at_the_first_lag_without_shared_positions(self):
+        self.assertAlmostEqual(turn_stats.fade_time_constant(math.exp(-1.0), 1.6), 1.6)
+        line = turn_stats.acf_row("x", [(9, 1.0), (8, 0.5), (7, 0.3), (6, 0.2),
+                                        (5, math.exp(-4.0)), (4, math.nan)], PERIOD)
+        self.assertEqual(line, "| x | 9 | 0.50 | 0.30 | 0.20 | 0.02 | - | 0.40 |")
+        self.assertEqual(turn_stats.acf_row("x", [(9, 1.0), (8, 0.5)], PERIOD),
+                         "| x | 9 | 0.50 | - |")
+
+
 class Files(unittest.TestCase):
     def setUp(self):
         self.tmp = tempfile.TemporaryDirectory()
@@ -104,6 +151,21 @@ class Files(unittest.TestCase):
         # A 1.6 m circle at 1 m/s: 0.625 rad/s, 72 degrees in 2 s.
         self.assertIn("samples (1 trials) | ", out[3])
         self.assertIn(" 0.63 / 0.63 / 0.63 | 100.0 | 0.0 | 72 / 72 / 72 | 100.0 | 0.0 |", out[3])
+
+    def test_the_autocorrelation_table_follows_when_asked(self):
+        recorded = self.write("zig.txt", "".join(
+            f"{10 * k} 1 {x:.9f} {y:.9f}\n" for k, (x, y) in enumerate(zigzag(4))))
+        out = subprocess.run([sys.executable, SCRIPT, "--acf-lags", "4", recorded], check=True,
+                             capture_output=True, text=True).stdout.splitlines()
+        self.assertEqual(len(out), 7)
+        self.assertEqual(out[3], "")
+        self.assertIn("autocorrelation at 0.4 s | 0.8 s | 1.2 s | 1.6 s | time constant from "
+                      "1.6 s", out[4])
+        self.assertEqual(out[6], "| zig.txt | 48 | 0.50 | 0.00 | 0.00 | 0.00 | 0.00 |")
+        run = subprocess.run([sys.executable, SCRIPT, "--acf-lags", "-1", recorded],
+                             capture_output=True, text=True)
+        self.assertNotEqual(run.returncode, 0)
+        self.assertIn("--acf-lags must be >= 0", run.stderr)
 
     def test_sample_files_named_one_by_one_make_one_row(self):
         rows = "t_s,person_x_m,person_y_m\n" + "".join(
