@@ -94,6 +94,7 @@ core::HumanEkfConfig human_ekf_config(const DaemonConfig& cfg) {
   c.yaw_accel_noise_radps2 = h.yaw_accel_noise_radps2;
   c.prediction_time_constant_s = h.prediction_time_constant_s;
   c.prediction_turn_time_constant_s = h.prediction_turn_time_constant_s;
+  c.prediction_heading_turn_time_constant_s = h.prediction_heading_turn_time_constant_s;
   c.gate_probability = h.gate_probability;
   c.reset_after_rejects = static_cast<uint32_t>(h.reset_after_rejects);
   c.reset_after_gap = core::from_ms(h.reset_after_gap_ms);

@@ -63,6 +63,13 @@ void apply_update(HumanTrack& t, const std::array<int, M>& rows,
   t.covariance() = 0.5 * (c + c.transpose());  // (a temporary: no aliasing with the transpose)
 }
 
+// Seconds of motion at the current rate that a prediction fading with tau amounts to by t (the
+// integral of exp(-t / tau)); tau 0 keeps the rate; before the stamp (t < 0) the track's own
+// constant-rate model.
+double faded_s(double t, double tau) {
+  return tau > 0.0 && t > 0.0 ? tau * -std::expm1(-t / tau) : t;
+}
+
 }  // namespace
 
 HumanTrack predict_track(const HumanTrack& track, Nanos t, const HumanEkfConfig& config) {
@@ -97,15 +104,10 @@ HumanTrack predict_track(const HumanTrack& track, Nanos t, const HumanEkfConfig&
 void predict_path(const HumanTrack& track, Nanos t0, double dt_s, double time_constant_s,
                   double turn_time_constant_s, std::span<Pose2> out) {
   const double t0_s = to_seconds(t0 - track.stamp);
-  // Seconds of motion at the current rate that the prediction amounts to by t (the integral of
-  // exp(-t / tau)); before the stamp the track's own constant-rate model.
-  const auto faded = [](double t, double tau) {
-    return tau > 0.0 && t > 0.0 ? tau * -std::expm1(-t / tau) : t;
-  };
   for (size_t k = 0; k < out.size(); ++k) {
     const double t = t0_s + dt_s * static_cast<double>(k);
-    const double s = faded(t, time_constant_s);
-    const double s_turn = faded(t, turn_time_constant_s);
+    const double s = faded_s(t, time_constant_s);
+    const double s_turn = faded_s(t, turn_time_constant_s);
     out[k] = Pose2{track.mean()(0) + track.mean()(3) * s, track.mean()(1) + track.mean()(4) * s,
                    wrap_angle(track.mean()(2) + track.mean()(5) * s_turn)};
   }
@@ -133,6 +135,16 @@ void predict_person_and_goal_paths(const HumanTrack& track, Nanos t0, double dt_
   }
   for (Pose2& g : goal)
     g = g * goal_in_person;
+  const double heading_turn_s = config.prediction_heading_turn_time_constant_s;
+  if (heading_turn_s > 0.0) {
+    const double t0_s = to_seconds(t0 - track.stamp);
+    for (size_t k = 0; k < goal.size(); ++k) {
+      const double t = t0_s + dt_s * static_cast<double>(k);
+      goal[k].theta_rad =
+          wrap_angle(track.mean()(2) + track.mean()(5) * faded_s(t, heading_turn_s) +
+                     goal_in_person.theta_rad);
+    }
+  }
 }
 
 Point2 position_at(const HumanTrack& track, Nanos t) {

@@ -445,6 +445,17 @@ std::vector<FieldSpec> build() {
        0.0,
        60.0,
        {}},
+      {"human.prediction_heading_turn_time_constant_s",
+       "s",
+       "How long the person's current turn rate lasts in q^d's heading alone over the "
+       "controller's horizon (its position keeps prediction_turn_time_constant_s). 0: as the "
+       "position. The base turns on the spot, so the heading it is asked for can stop turning "
+       "sooner than the point it is asked to be at: with the position's 2 s the robot overshoots "
+       "the heading of every turn (docs/EVALUATION.md, forty-first session).",
+       FIELD(human.prediction_heading_turn_time_constant_s),
+       0.0,
+       60.0,
+       {}},
       {"human.gate_probability",
        "-",
        "Chi-square gate of the filter: a pose outside this probability mass is an outlier (0.99, "

@@ -280,6 +280,15 @@ TEST(Config, ThePredictedTurnRateTimeConstantReachesTheFilterConfig) {
   EXPECT_DOUBLE_EQ(firmware::human_ekf_config(*set.config).prediction_turn_time_constant_s, 0.5);
   EXPECT_FALSE(
       load_config_text("human:\n  prediction_turn_time_constant_s: -1\n", "test.yaml").ok());
+  EXPECT_DOUBLE_EQ(d.prediction_heading_turn_time_constant_s, 0.0) << "the default: as q^d";
+  const auto heading =
+      load_config_text("human:\n  prediction_heading_turn_time_constant_s: 0.4\n", "test.yaml");
+  ASSERT_TRUE(heading.ok()) << heading.errors[0].to_string();
+  EXPECT_DOUBLE_EQ(
+      firmware::human_ekf_config(*heading.config).prediction_heading_turn_time_constant_s, 0.4);
+  EXPECT_FALSE(
+      load_config_text("human:\n  prediction_heading_turn_time_constant_s: nan\n", "test.yaml")
+          .ok());
 }
 
 TEST(Config, TheTrackingFrameIsAChoiceThatReachesTheController) {

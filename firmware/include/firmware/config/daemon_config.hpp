@@ -66,6 +66,7 @@ struct DaemonConfig {
     double yaw_accel_noise_radps2 = 0;
     double prediction_time_constant_s = 0;
     double prediction_turn_time_constant_s = 0;
+    double prediction_heading_turn_time_constant_s = 0;
     double gate_probability = 0;
     int64_t reset_after_rejects = 0;
     int64_t reset_after_gap_ms = 0;
