@@ -253,6 +253,7 @@ Daemon::Daemon(const DaemonConfig& cfg, hal::SystemdNotifier& notifier)
       use_pid_(cfg.control.controller == "pid_follower"),
       person_path_(static_cast<size_t>(cfg.mppi.horizon_steps) + 1),
       goal_path_(person_path_.size()),
+      goal_heading_path_(person_path_.size()),
       gate_(stop_limits(cfg)),
       base_send_warning_(core::from_ms(cfg.logging.warning_interval_ms)) {}
 
@@ -619,6 +620,13 @@ bool Daemon::run_controller(Nanos now, core::BodyVelocity& requested) {
   const core::Pose2 goal_in_person = goal->value.goal_in_person();
   core::predict_person_and_goal_paths(track->value, now, mppi_.config().step_s, human_config_,
                                       goal_in_person, person_path_, goal_path_);
+  // q^d's heading may stop turning sooner than its place (human.
+  // prediction_heading_turn_time_constant_s): the base turns on the spot.
+  const double heading_turn_s = human_config_.prediction_heading_turn_time_constant_s;
+  if (heading_turn_s > 0.0) {
+    core::predict_goal_headings(track->value, now, mppi_.config().step_s, heading_turn_s,
+                                goal_in_person.theta_rad, goal_heading_path_);
+  }
   const auto map = costmap_.latest();
 
   core::MppiInputs in;
@@ -626,6 +634,7 @@ bool Daemon::run_controller(Nanos now, core::BodyVelocity& requested) {
   in.current = last_command_;
   in.goal = goal->value.goal_odom;
   in.goal_path = goal_path_;
+  if (heading_turn_s > 0.0) in.goal_heading_path = goal_heading_path_;
   in.person = person_path_;
   in.costmap = map.get();
   in.now = now;

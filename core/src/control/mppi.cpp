@@ -492,8 +492,8 @@ MppiOutput Mppi::step(const MppiInputs& in) {
   }
   for (size_t k = 0; k < in.goal_path.size() && k < goal_frames_.capacity(); ++k) {
     const Pose2& g = in.goal_path[k];
-    goal_frames_.push_back(
-        {g.x_m, g.y_m, g.theta_rad, std::cos(g.theta_rad), std::sin(g.theta_rad)});
+    const double heading = k < in.goal_heading_path.size() ? in.goal_heading_path[k] : g.theta_rad;
+    goal_frames_.push_back({g.x_m, g.y_m, heading, std::cos(g.theta_rad), std::sin(g.theta_rad)});
   }
   robot_cos_ = std::cos(in.robot.theta_rad);
   robot_sin_ = std::sin(in.robot.theta_rad);

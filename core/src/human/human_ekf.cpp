@@ -135,15 +135,16 @@ void predict_person_and_goal_paths(const HumanTrack& track, Nanos t0, double dt_
   }
   for (Pose2& g : goal)
     g = g * goal_in_person;
-  const double heading_turn_s = config.prediction_heading_turn_time_constant_s;
-  if (heading_turn_s > 0.0) {
-    const double t0_s = to_seconds(t0 - track.stamp);
-    for (size_t k = 0; k < goal.size(); ++k) {
-      const double t = t0_s + dt_s * static_cast<double>(k);
-      goal[k].theta_rad =
-          wrap_angle(track.mean()(2) + track.mean()(5) * faded_s(t, heading_turn_s) +
-                     goal_in_person.theta_rad);
-    }
+}
+
+void predict_goal_headings(const HumanTrack& track, Nanos t0, double dt_s,
+                           double turn_time_constant_s, double goal_heading_in_person_rad,
+                           std::span<double> out) {
+  const double t0_s = to_seconds(t0 - track.stamp);
+  for (size_t k = 0; k < out.size(); ++k) {
+    const double t = t0_s + dt_s * static_cast<double>(k);
+    out[k] = wrap_angle(track.mean()(2) + track.mean()(5) * faded_s(t, turn_time_constant_s) +
+                        goal_heading_in_person_rad);
   }
 }
 

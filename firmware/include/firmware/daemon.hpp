@@ -290,10 +290,11 @@ class Daemon {  // NOLINT(clang-analyzer-optin.performance.Padding)
   // control task state
   core::Mppi mppi_;
   core::PidFollower pid_;
-  bool use_pid_ = false;                  // control.controller: pid_follower (evaluation baseline)
-  std::vector<core::Pose2> person_path_;  // the person's predicted poses at the MPPI steps
-  std::vector<core::Pose2> goal_path_;    // q^d carried along the person's faded prediction
-  core::Twist last_command_;              // the gate's previous output (MPPI's start control)
+  bool use_pid_ = false;                   // control.controller: pid_follower (evaluation baseline)
+  std::vector<core::Pose2> person_path_;   // the person's predicted poses at the MPPI steps
+  std::vector<core::Pose2> goal_path_;     // q^d carried along the person's faded prediction
+  std::vector<double> goal_heading_path_;  // q^d's heading alone (its own turn fading), rad
+  core::Twist last_command_;               // the gate's previous output (MPPI's start control)
   ControlStatus control_state_;
   core::LatestValue<ControlStatus> control_status_;
   core::MotionGate gate_;

@@ -8,6 +8,7 @@
 #include <limits>
 #include <numbers>
 #include <random>
+#include <vector>
 
 #include "core/control/dcbf_repair.hpp"
 #include "core/control/mppi.hpp"
@@ -45,7 +46,7 @@ struct Loop {
   explicit Loop(const core::MppiConfig& c) : mppi(c) {}
   core::MppiOutput tick(const Pose2& goal, std::span<const Pose2> person,
                         const core::Costmap* map) {
-    core::MppiInputs in{robot, last, goal, person, map, t, {}};
+    core::MppiInputs in{robot, last, goal, person, map, t, {}, {}};
     const auto out = mppi.step(in);
     robot = integrate(robot, out.command, 0.01);  // 100 Hz
     last = out.command;
@@ -93,6 +94,46 @@ TEST(Mppi, TheTrackingFrameDecidesWhichErrorQWeighs) {
     EXPECT_NEAR(weighed, 1.5, 0.15);
     EXPECT_NEAR(loop.robot.theta_rad, 0.0, 0.01);
   }
+}
+
+// q^d's heading may come on its own (MppiInputs::goal_heading_path): it is the heading the robot
+// is asked for, while the frame its position error is weighed in stays goal_path's.
+TEST(Mppi, AHeadingPathSetsTheHeadingTargetAndLeavesThePositionsFrame) {
+  // The heading: goal_path faces 0, the heading path 0.7 rad: the robot turns to 0.7.
+  {
+    Loop loop(test_config());
+    const std::vector<Pose2> path(31, Pose2{0.0, 0.0, 0.0});
+    const std::vector<double> heading(31, 0.7);
+    for (int i = 0; i < 300; ++i) {
+      const core::MppiInputs in{loop.robot, loop.last, path[0], {}, nullptr, loop.t, path, heading};
+      const auto out = loop.mppi.step(in);
+      ASSERT_TRUE(out.ok);
+      loop.robot = integrate(loop.robot, out.command, 0.01);
+      loop.last = out.command;
+      loop.t += 10ms;
+    }
+    EXPECT_NEAR(loop.robot.theta_rad, 0.7, 0.05);
+    EXPECT_NEAR(std::hypot(loop.robot.x_m, loop.robot.y_m), 0.0, 0.1);
+  }
+  // The frame: only c_x weighs, goal_path faces a quarter turn (its x is odom's y), the heading
+  // path faces 0 and the robot cannot turn. The robot goes to the goal's y, as
+  // TheTrackingFrameDecidesWhichErrorQWeighs does without a heading path: the frame is
+  // goal_path's.
+  core::MppiConfig c = test_config();
+  c.q = {50.0, 0.0, 0.0};
+  c.limits.wz = 1e-3;
+  Loop loop(c);
+  const std::vector<Pose2> path(31, Pose2{1.5, 1.5, std::numbers::pi / 2});
+  const std::vector<double> heading(31, 0.0);
+  for (int i = 0; i < 400; ++i) {
+    const core::MppiInputs in{loop.robot, loop.last, path[0], {}, nullptr, loop.t, path, heading};
+    const auto out = loop.mppi.step(in);
+    ASSERT_TRUE(out.ok);
+    loop.robot = integrate(loop.robot, out.command, 0.01);
+    loop.last = out.command;
+    loop.t += 10ms;
+  }
+  EXPECT_NEAR(loop.robot.y_m, 1.5, 0.15) << "c_x's axis is goal_path's heading";
 }
 
 TEST(Mppi, NeverEntersTheEllipseOfAPersonWalkingTowardTheRobot) {
@@ -262,7 +303,7 @@ TEST(Mppi, TheSteeringSampleTracksAWalkingGoalWithoutLag) {
     const double s0 = t < 2.0 ? 0.25 * t * t : 1.0 + (t - 2.0);
     for (size_t k = 0; k < path.size(); ++k)
       path[k] = on_circle(s0 + v * kTauS * -std::expm1(-0.1 * static_cast<double>(k) / kTauS));
-    const core::MppiInputs in{loop.robot, loop.last, path[0], {}, nullptr, loop.t, path};
+    const core::MppiInputs in{loop.robot, loop.last, path[0], {}, nullptr, loop.t, path, {}};
     const auto out = loop.mppi.step(in);
     ASSERT_TRUE(out.ok);
     loop.robot = integrate(loop.robot, out.command, 0.01);

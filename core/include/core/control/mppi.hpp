@@ -128,6 +128,10 @@ struct MppiInputs {
   // q^d at steps 0..K (odom) when it moves with the person (the interactive space is attached
   // to them); empty: `goal` at every step.
   std::span<const Pose2> goal_path;
+  // q^d's heading at steps 0..K when it turns on its own (predict_goal_headings); empty: each
+  // step's goal_path heading. Only the heading target: the frame the position error is weighed
+  // in (tracking_frame kGoal) stays goal_path's, the person's predicted way.
+  std::span<const double> goal_heading_path;
 };
 
 // The best rollout's cost by term (they sum to its total): what the controller is trading off.
@@ -211,7 +215,7 @@ class Mppi {
   };
   std::vector<PersonFrame> person_frames_;  // K + 1 (capacity fixed at construction)
   struct GoalFrame {
-    double x, y, theta, c, s;  // q^d at a step and its heading's cos/sin
+    double x, y, theta, c, s;  // q^d at a step, its heading and its frame's cos/sin
   };
   std::vector<GoalFrame> goal_frames_;  // 1 or K + 1 (capacity fixed at construction)
   double robot_cos_ = 1, robot_sin_ = 0;

@@ -38,9 +38,10 @@ struct HumanEkfConfig {
   // The same for the person's turn rate (0: as the velocity: prediction_time_constant_s for
   // q^d's path, constant for the barrier's person). See predict_path.
   double prediction_turn_time_constant_s = 0.0;
-  // How long the turn rate lasts in q^d's heading alone (0: as its position, the line above).
-  // A mecanum base turns without moving: the heading it is asked for over the horizon can fade
-  // sooner than the carrier that places q^d (docs/EVALUATION.md, forty-first session).
+  // How long the turn rate lasts in q^d's heading alone (0: as its position, the line above;
+  // predict_goal_headings). A mecanum base turns without moving: the heading it is asked for over
+  // the horizon can fade sooner than the carrier that places q^d and orients its error
+  // (docs/EVALUATION.md, forty-first session).
   double prediction_heading_turn_time_constant_s = 0.0;
 };
 
@@ -120,12 +121,16 @@ void predict_path(const HumanTrack& track, Nanos t0, double dt_s, double time_co
 // config.prediction_time_constant_s and whose turn rate fades as
 // config.prediction_turn_time_constant_s (0: as the velocity; `goal_in_person`: q^d in the frame
 // of the person it was chosen for); a q^d ahead of the person (x > 0) rides the barrier's person
-// instead, so the barrier's person never walks into it. With
-// config.prediction_heading_turn_time_constant_s > 0, q^d's heading (not its position) turns as
-// the track's turn rate faded with that time constant, wherever q^d rides.
+// instead, so the barrier's person never walks into it.
 void predict_person_and_goal_paths(const HumanTrack& track, Nanos t0, double dt_s,
                                    const HumanEkfConfig& config, const Pose2& goal_in_person,
                                    std::span<Pose2> person, std::span<Pose2> goal);
+// q^d's heading alone at t0, t0 + dt, ... (out.size() values): the person's heading turning at
+// the track's turn rate faded with `turn_time_constant_s`, plus q^d's heading in the person's
+// frame (HumanEkfConfig::prediction_heading_turn_time_constant_s; MppiInputs::goal_heading_path).
+void predict_goal_headings(const HumanTrack& track, Nanos t0, double dt_s,
+                           double turn_time_constant_s, double goal_heading_in_person_rad,
+                           std::span<double> out);
 // The person's position at t (before or after the track's stamp), constant velocity.
 Point2 position_at(const HumanTrack& track, Nanos t);
 
