@@ -451,7 +451,9 @@ std::vector<FieldSpec> build() {
        "controller's horizon (its position keeps prediction_turn_time_constant_s). 0: as the "
        "position. The base turns on the spot, so the heading it is asked for can stop turning "
        "sooner than the point it is asked to be at: with the position's 2 s the robot overshoots "
-       "the heading of every turn (docs/EVALUATION.md, forty-first session).",
+       "the heading of every turn. Measured with 0.3: on gentle walks 49 of 50 against 47, e_theta "
+       "0.088 against 0.096 rad; on sharp ones e_theta not lower, and 37 of 40 crowd trials "
+       "against 38 (docs/EVALUATION.md, forty-first session).",
        FIELD(human.prediction_heading_turn_time_constant_s),
        0.0,
        60.0,
