@@ -376,16 +376,22 @@ TEST(ClosedLoop, TheDaemonsPersonIsWhereTheyAreWhileTheRobotDrives) {
   EXPECT_TRUE(r.metrics.success) << r.metrics.failure;
 }
 
+// The open world with the person walking a 6 m square at 1.2 m/s, cornering left at 1 rad/s.
+SimRunOptions cornering_square() {
+  auto o = scenario("open");
+  sim::CornerLimits corner;
+  corner.turn_rate_radps = 1.0;
+  o.scenario.person = sim::walk(
+      {{{0, 0}}, {{6, 0}, 1.2}, {{6, 6}, 1.2}, {{0, 6}, 1.2}, {{0, 0}, 1.2}}, 2.0, 0.05, corner);
+  return o;
+}
+
 TEST(ClosedLoop, WithTheGyroTheDaemonKnowsThePersonsTurnRateSooner) {
   // Round a square at 1.2 m/s, cornering at 1 rad/s. The worn sensor's gyro reaches the daemon
   // in its 0x1A frames over the serial link; with human.use_gyro the filter's turn rate follows
   // the corners where from the headings alone it lags them by ~0.1 s.
   auto run = [](bool use_gyro) {
-    auto o = scenario("open");
-    sim::CornerLimits corner;
-    corner.turn_rate_radps = 1.0;
-    o.scenario.person = sim::walk(
-        {{{0, 0}}, {{6, 0}, 1.2}, {{6, 6}, 1.2}, {{0, 6}, 1.2}, {{0, 0}, 1.2}}, 2.0, 0.05, corner);
+    auto o = cornering_square();
     o.config.human.use_gyro = use_gyro;
     o.duration_s = 12.5;  // two corners
     double se = 0;
@@ -417,11 +423,7 @@ TEST(ClosedLoop, QdsHeadingOnItsOwnStopsTheRobotTurningPastThePersonAfterACorner
   // human.prediction_heading_turn_time_constant_s the heading alone fades in 0.3 s and the robot
   // stops turning near the person's heading (docs/EVALUATION.md, forty-first session).
   auto run = [](double heading_turn_s) {
-    auto o = scenario("open");
-    sim::CornerLimits corner;
-    corner.turn_rate_radps = 1.0;
-    o.scenario.person = sim::walk(
-        {{{0, 0}}, {{6, 0}, 1.2}, {{6, 6}, 1.2}, {{0, 6}, 1.2}, {{0, 0}, 1.2}}, 2.0, 0.05, corner);
+    auto o = cornering_square();
     o.config.human.prediction_heading_turn_time_constant_s = heading_turn_s;
     o.duration_s = 12.5;       // two corners
     double overshoot_rad = 0;  // the robot's heading past the person's (left turns: robot > person)

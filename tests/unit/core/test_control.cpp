@@ -46,8 +46,13 @@ struct Loop {
   explicit Loop(const core::MppiConfig& c) : mppi(c) {}
   core::MppiOutput tick(const Pose2& goal, std::span<const Pose2> person,
                         const core::Costmap* map) {
-    core::MppiInputs in{robot, last, goal, person, map, t, {}, {}};
-    const auto out = mppi.step(in);
+    return advance(mppi.step({robot, last, goal, person, map, t, {}, {}}));
+  }
+  // q^d walking a path, its heading from `heading` when that is not empty; no person, no map.
+  core::MppiOutput tick_path(std::span<const Pose2> goal_path, std::span<const double> heading) {
+    return advance(mppi.step({robot, last, goal_path[0], {}, nullptr, t, goal_path, heading}));
+  }
+  core::MppiOutput advance(const core::MppiOutput& out) {
     robot = integrate(robot, out.command, 0.01);  // 100 Hz
     last = out.command;
     t += 10ms;
@@ -104,14 +109,8 @@ TEST(Mppi, AHeadingPathSetsTheHeadingTargetAndLeavesThePositionsFrame) {
     Loop loop(test_config());
     const std::vector<Pose2> path(31, Pose2{0.0, 0.0, 0.0});
     const std::vector<double> heading(31, 0.7);
-    for (int i = 0; i < 300; ++i) {
-      const core::MppiInputs in{loop.robot, loop.last, path[0], {}, nullptr, loop.t, path, heading};
-      const auto out = loop.mppi.step(in);
-      ASSERT_TRUE(out.ok);
-      loop.robot = integrate(loop.robot, out.command, 0.01);
-      loop.last = out.command;
-      loop.t += 10ms;
-    }
+    for (int i = 0; i < 300; ++i)
+      ASSERT_TRUE(loop.tick_path(path, heading).ok);
     EXPECT_NEAR(loop.robot.theta_rad, 0.7, 0.05);
     EXPECT_NEAR(std::hypot(loop.robot.x_m, loop.robot.y_m), 0.0, 0.1);
   }
@@ -125,14 +124,8 @@ TEST(Mppi, AHeadingPathSetsTheHeadingTargetAndLeavesThePositionsFrame) {
   Loop loop(c);
   const std::vector<Pose2> path(31, Pose2{1.5, 1.5, std::numbers::pi / 2});
   const std::vector<double> heading(31, 0.0);
-  for (int i = 0; i < 400; ++i) {
-    const core::MppiInputs in{loop.robot, loop.last, path[0], {}, nullptr, loop.t, path, heading};
-    const auto out = loop.mppi.step(in);
-    ASSERT_TRUE(out.ok);
-    loop.robot = integrate(loop.robot, out.command, 0.01);
-    loop.last = out.command;
-    loop.t += 10ms;
-  }
+  for (int i = 0; i < 400; ++i)
+    ASSERT_TRUE(loop.tick_path(path, heading).ok);
   EXPECT_NEAR(loop.robot.y_m, 1.5, 0.15) << "c_x's axis is goal_path's heading";
 }
 
@@ -303,12 +296,8 @@ TEST(Mppi, TheSteeringSampleTracksAWalkingGoalWithoutLag) {
     const double s0 = t < 2.0 ? 0.25 * t * t : 1.0 + (t - 2.0);
     for (size_t k = 0; k < path.size(); ++k)
       path[k] = on_circle(s0 + v * kTauS * -std::expm1(-0.1 * static_cast<double>(k) / kTauS));
-    const core::MppiInputs in{loop.robot, loop.last, path[0], {}, nullptr, loop.t, path, {}};
-    const auto out = loop.mppi.step(in);
+    const auto out = loop.tick_path(path, {});
     ASSERT_TRUE(out.ok);
-    loop.robot = integrate(loop.robot, out.command, 0.01);
-    loop.last = out.command;
-    loop.t += 10ms;
     if (t >= 8.0) {
       const Pose2 e = loop.robot.inverse() * path[0];  // q^d in the robot's frame
       along += e.x_m;
