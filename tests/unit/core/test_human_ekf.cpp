@@ -338,15 +338,22 @@ TEST(HumanEkf, TheTurnRateFadesWithItsOwnTimeConstant) {
   }
 }
 
+// A valid track at the origin, stamped at 1 s: heading (rad), velocity (m/s), turn rate (rad/s).
+core::HumanTrack walking_track(double heading_rad, double vx_mps, double vy_mps,
+                               double yaw_rate_radps) {
+  core::HumanTrack track;
+  track.valid = true;
+  track.mean() << 0.0, 0.0, heading_rad, vx_mps, vy_mps, yaw_rate_radps;
+  track.stamp = 1s;
+  return track;
+}
+
 // One rule for the daemon's controller and the evaluation's snapshots: the barrier's person at
 // constant velocity and turn rate, q^d's carrier faded, turning as
 // prediction_turn_time_constant_s says (random seed 112 of docs/EVALUATION.md: a person turning
 // round toward the robot, predicted walking off on a faded turn, was touched).
 TEST(HumanEkf, TheBarriersPersonKeepsTurningWhileQdsCarrierFades) {
-  core::HumanTrack track;
-  track.valid = true;
-  track.mean() << 0.0, 0.0, 0.0, 1.5, 0.0, 2.0;
-  track.stamp = 1s;
+  const core::HumanTrack track = walking_track(0.0, 1.5, 0.0, 2.0);
   std::array<Pose2, 11> person{};
   std::array<Pose2, 11> goal{};
   core::HumanEkfConfig c;
@@ -401,10 +408,7 @@ TEST(HumanEkf, TheBarriersPersonKeepsTurningWhileQdsCarrierFades) {
 // q^d's heading may stop turning sooner than its position (forty-first session of
 // docs/EVALUATION.md: with the position's 2 s the robot overshot the heading of every turn).
 TEST(HumanEkf, QdsHeadingAloneFadesItsTurnWithItsOwnTimeConstant) {
-  core::HumanTrack track;
-  track.valid = true;
-  track.mean() << 0.0, 0.0, 0.3, 1.2, 0.4, 1.5;
-  track.stamp = 1s;
+  core::HumanTrack track = walking_track(0.3, 1.2, 0.4, 1.5);
   std::array<double, 21> heading{};
   core::predict_goal_headings(track, 1s, 0.1, 0.4, 0.1, heading);  // q^d 0.1 rad off their way
   for (size_t k = 0; k < heading.size(); ++k) {
