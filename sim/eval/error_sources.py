@@ -2,7 +2,7 @@
 """Where a run's tracking error comes from: each sample's e² put to the event it follows.
 
     sim/eval/error_sources.py DIR_OR_CSV... [--window-s 2] [--jump-m 0.3] [--turn-rad-s 0.5]
-                              [--pedestrian-m 1.5]
+                              [--pedestrian-m 1.5] [--speed-change-mps2 A]
 
 Reads the sample files of `companion-eval --samples` (the directories or single files; the
 `-world.csv` files beside them are skipped) and sorts every active sample with a q^d into the
@@ -15,6 +15,9 @@ first event of this list that holds for it:
                   (q^d, fixed in their frame, swings round with them); only after the turning
                   sample, as for every event here: its error follows it (heading_bound.py's
                   turn_share, a share of e_theta² for its bound, counts the window both sides);
+  speed change    only with --speed-change-mps2 A > 0: within --window-s of the person's speed
+                  changing faster than A m/s² from one sample to the next (starting, stopping,
+                  slowing to turn back: q^d, fixed in their frame, speeds up or brakes with them);
   pedestrian near a pedestrian within --pedestrian-m of the robot (the robot giving way);
   steady          none of these.
 
@@ -33,6 +36,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import eval_samples  # noqa: E402
 
 EVENTS = ("q^d moved", "person turning", "pedestrian near", "steady")
+SPEED_CHANGE = "speed change"  # between "person turning" and "pedestrian near", when asked for
+EVENTS_WITH_SPEED = EVENTS[:2] + (SPEED_CHANGE,) + EVENTS[2:]
 
 
 def goal_in_person_frame(row):
@@ -42,14 +47,28 @@ def goal_in_person_frame(row):
     return (math.cos(pth) * dx + math.sin(pth) * dy, -math.sin(pth) * dx + math.cos(pth) * dy)
 
 
-def classify(rows, window_s, jump_m, turn_rad_s, pedestrian_m):
-    """(event, TrackedSample) for each active row with a q^d, in time order."""
+def person_speeds(rows):
+    """The person's speed (m/s) at each row, from the step since the row before (0 at the
+    first)."""
+    out = [0.0]
+    for a, b in zip(rows, rows[1:]):
+        dt = float(b["t_s"]) - float(a["t_s"])
+        step = math.hypot(float(b["person_x_m"]) - float(a["person_x_m"]),
+                          float(b["person_y_m"]) - float(a["person_y_m"]))
+        out.append(step / dt if dt > 0 else out[-1])
+    return out
+
+
+def classify(rows, window_s, jump_m, turn_rad_s, pedestrian_m, speed_change_mps2=0.0):
+    """(event, TrackedSample) for each active row with a q^d, in time order. speed_change_mps2
+    > 0 adds the event "speed change" (EVENTS_WITH_SPEED)."""
     rows = [r for r in rows if r["active"] == "1" and r["has_goal"] == "1"]
     errors = eval_samples.tracking_errors(rows)
-    last_jump_s = last_turn_s = -math.inf
+    speeds = person_speeds(rows)
+    last_jump_s = last_turn_s = last_speed_change_s = -math.inf
     previous = None
     out = []
-    for row, e in zip(rows, errors):
+    for i, (row, e) in enumerate(zip(rows, errors)):
         goal = goal_in_person_frame(row)
         if previous is not None:
             previous_goal, previous_theta, previous_t = previous
@@ -59,11 +78,16 @@ def classify(rows, window_s, jump_m, turn_rad_s, pedestrian_m):
             turned = abs(eval_samples.wrap(e.person_theta_rad - previous_theta))
             if dt > 0 and turned / dt > turn_rad_s:
                 last_turn_s = e.t_s
+            if (speed_change_mps2 > 0 and i >= 2 and dt > 0 and
+                    abs(speeds[i] - speeds[i - 1]) / dt > speed_change_mps2):
+                last_speed_change_s = e.t_s
         previous = (goal, e.person_theta_rad, e.t_s)
         if e.t_s - last_jump_s <= window_s:
             event = EVENTS[0]
         elif e.t_s - last_turn_s <= window_s:
             event = EVENTS[1]
+        elif e.t_s - last_speed_change_s <= window_s:
+            event = SPEED_CHANGE
         elif float(row["nearest_pedestrian_m"]) < pedestrian_m:
             event = EVENTS[2]
         else:
@@ -72,9 +96,10 @@ def classify(rows, window_s, jump_m, turn_rad_s, pedestrian_m):
     return out
 
 
-def table(classified):
-    """The Markdown table of error_sources for (event, TrackedSample) pairs."""
-    sums = {ev: [0, 0.0, 0.0, 0.0] for ev in EVENTS}
+def table(classified, events=EVENTS):
+    """The Markdown table of error_sources for (event, TrackedSample) pairs, one row per event of
+    `events`."""
+    sums = {ev: [0, 0.0, 0.0, 0.0] for ev in events}
     for event, e in classified:
         s = sums[event]
         s[0] += 1
@@ -89,7 +114,7 @@ def table(classified):
              f"{math.sqrt(total[1] / n):.3f} m, e_θ {math.sqrt(total[2] / n):.3f} rad", "",
              "| event | time % | e_x² % | e_y² % | e_θ² % | RMSE e_x / e_y / e_θ within |",
              "|---|---|---|---|---|---|"]
-    for event in EVENTS:
+    for event in events:
         count, *sq = sums[event]
         if count == 0:
             lines.append(f"| {event} | 0.0 | 0.0 | 0.0 | 0.0 | - |")
@@ -122,8 +147,10 @@ def main():
     ap.add_argument("--jump-m", type=float, default=0.3)
     ap.add_argument("--turn-rad-s", type=float, default=0.5)
     ap.add_argument("--pedestrian-m", type=float, default=1.5)
+    ap.add_argument("--speed-change-mps2", type=float, default=0.0,
+                    help="add the event 'speed change' at this acceleration (0: off)")
     args = ap.parse_args()
-    for name in ("window_s", "jump_m", "turn_rad_s", "pedestrian_m"):
+    for name in ("window_s", "jump_m", "turn_rad_s", "pedestrian_m", "speed_change_mps2"):
         value = getattr(args, name)
         if not math.isfinite(value) or value < 0:
             ap.error(f"--{name.replace('_', '-')} must be a finite number >= 0, not {value}")
@@ -134,12 +161,13 @@ def main():
     for f in files:
         try:
             trials.append(classify(eval_samples.read_rows(f), args.window_s, args.jump_m,
-                                   args.turn_rad_s, args.pedestrian_m))
+                                   args.turn_rad_s, args.pedestrian_m, args.speed_change_mps2))
         except OSError as err:
             sys.exit(f"error_sources: {err}")
         except (KeyError, ValueError) as err:
             sys.exit(f"error_sources: {f}: not a companion-eval sample file ({err})")
-    print(f"{len(files)} trials; " + table([c for t in trials for c in t]), end="")
+    events = EVENTS_WITH_SPEED if args.speed_change_mps2 > 0 else EVENTS
+    print(f"{len(files)} trials; " + table([c for t in trials for c in t], events), end="")
     for label, event in (("every sample", None), ("steady samples only", EVENTS[-1])):
         means, n = mean_trial_rmse(trials, event)
         if means is not None:

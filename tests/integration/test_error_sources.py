@@ -22,14 +22,17 @@ COLUMNS = ["t_s", "robot_x_m", "robot_y_m", "robot_theta_rad", "person_x_m", "pe
            "nearest_pedestrian_m"]
 
 
-def walk(n=100, goal_in_person=None, heading=None, pedestrian_m=None, robot_offset=(0.0, 0.1)):
-    """Rows of a person walking at 1 m/s; q^d at goal_in_person(k) in their frame (1 m behind
-    by default), the robot at q^d minus robot_offset in the person's frame, facing their way."""
+def walk(n=100, goal_in_person=None, heading=None, pedestrian_m=None, robot_offset=(0.0, 0.1),
+         speed=None):
+    """Rows of a person walking at speed(k) m/s (1 by default); q^d at goal_in_person(k) in
+    their frame (1 m behind by default), the robot at q^d minus robot_offset in the person's
+    frame, facing their way."""
     rows = []
     x = y = 0.0
     for k in range(n):
         th = 0.0 if heading is None else heading(k)
-        x, y = x + DT * math.cos(th), y + DT * math.sin(th)
+        v = 1.0 if speed is None else speed(k)
+        x, y = x + DT * v * math.cos(th), y + DT * v * math.sin(th)
         gx, gy = (-1.0, 0.0) if goal_in_person is None else goal_in_person(k)
         c, s = math.cos(th), math.sin(th)
         goal = (x + c * gx - s * gy, y + s * gx + c * gy)
@@ -93,6 +96,27 @@ class ErrorSources(unittest.TestCase):
         self.assertEqual(ev[61:], ["pedestrian near"] * 39)
         self.assertEqual(ev[:31], ["pedestrian near"] * 31)
 
+    def test_a_stop_is_a_speed_change_only_when_asked_for(self):
+        # Walking at 1 m/s, braking at 2 m/s² from sample 50 (0.2 m/s a sample) to a standstill
+        # at sample 55, then standing until sample 99.
+        stop = walk(speed=lambda k: max(0.0, 1.0 - 0.2 * max(0, k - 49)))
+        self.assertEqual(set(events(stop)), {"steady"})
+        labels = events(stop, speed_change_mps2=1.0)
+        # The first change is seen at sample 50 (its step is 0.8 m/s, the one before 1.0 m/s);
+        # the last at 54 (0.0 against 0.2); 2 s after it, sample 74, is the window's last.
+        self.assertEqual(labels[:50], ["steady"] * 50)
+        self.assertEqual(labels[50:75], ["speed change"] * 25)
+        self.assertEqual(labels[75:], ["steady"] * 25)
+        # Braking at 2 m/s² is not a change faster than 3 m/s².
+        self.assertEqual(set(events(stop, speed_change_mps2=3.0)), {"steady"})
+        # A turn at the same time comes first in the list.
+        turning = walk(speed=lambda k: max(0.0, 1.0 - 0.2 * max(0, k - 49)),
+                       heading=lambda k: 0.0 if k < 50 else 0.1 * (k - 49))
+        self.assertEqual(events(turning, speed_change_mps2=1.0)[50:55], ["person turning"] * 5)
+        text = error_sources.table(error_sources.classify(stop, 2.0, 0.3, 0.5, 1.5, 1.0),
+                                   error_sources.EVENTS_WITH_SPEED)
+        self.assertIn("| speed change | 25.0 | 0.0 | 25.0 | 0.0 | 0.000 / 0.100 / 0.000 |", text)
+
     def test_inactive_samples_and_samples_without_q_d_are_left_out(self):
         rows = walk(n=10)
         rows[2]["active"] = "0"
@@ -136,10 +160,14 @@ class ErrorSources(unittest.TestCase):
                 f.write("kind,x_m,y_m\nwall,0,0\n")
             out = subprocess.run([sys.executable, SCRIPT, d], capture_output=True, text=True,
                                  check=True).stdout
+            asked = subprocess.run([sys.executable, SCRIPT, d, "--speed-change-mps2", "1"],
+                                   capture_output=True, text=True, check=True).stdout
         self.assertTrue(out.startswith("2 trials; 150 samples;"), out)
         self.assertIn("| steady | 100.0 |", out)
         self.assertIn("Mean of the per-trial RMSE (steady samples only, 2 trials): e_x 0.000 m, "
                       "e_y 0.100 m", out)
+        self.assertNotIn("speed change", out)
+        self.assertIn("| speed change | 0.0 | 0.0 | 0.0 | 0.0 | - |", asked)
 
     def test_a_file_that_is_not_a_sample_file_is_a_clear_error(self):
         with tempfile.TemporaryDirectory() as d:
@@ -156,7 +184,8 @@ class ErrorSources(unittest.TestCase):
             self.assertNotIn("Traceback", r.stderr)
 
     def test_a_threshold_that_is_not_a_distance_or_a_time_is_a_clear_error(self):
-        for flag, value in (("--window-s", "-1"), ("--jump-m", "nan"), ("--turn-rad-s", "inf")):
+        for flag, value in (("--window-s", "-1"), ("--jump-m", "nan"), ("--turn-rad-s", "inf"),
+                            ("--speed-change-mps2", "-2")):
             r = subprocess.run([sys.executable, SCRIPT, HERE, flag, value], capture_output=True,
                                text=True)
             self.assertEqual(r.returncode, 2, (flag, r.stderr))
