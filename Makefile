@@ -46,7 +46,7 @@ eval: deps
 	sim/eval/run_benchmark.sh $(EVAL_OUT)
 
 # PPO training of the learned selector (sim/training; LibTorch): writes TRAIN_OUT for policy.file
-# (docs/EVALUATION.md, "The learned policy").
+# (docs/eval/SESSIONS.md, "The learned policy").
 TRAIN_OUT ?= build/policy.bin
 TRAIN_STEPS ?= 1000000
 TRAIN_ARGS ?=

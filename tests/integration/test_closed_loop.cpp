@@ -421,7 +421,7 @@ TEST(ClosedLoop, QdsHeadingOnItsOwnStopsTheRobotTurningPastThePersonAfterACorner
   // turning at the filter's rate faded over 2 s (the position's time constant): at each corner's
   // end the robot is turning fast and swings past the person's new heading. With
   // human.prediction_heading_turn_time_constant_s the heading alone fades in 0.3 s and the robot
-  // stops turning near the person's heading (docs/EVALUATION.md, forty-first session).
+  // stops turning near the person's heading (docs/eval/SESSIONS.md, forty-first session).
   auto run = [](double heading_turn_s) {
     auto o = cornering_square();
     o.config.human.prediction_heading_turn_time_constant_s = heading_turn_s;
@@ -707,7 +707,7 @@ TEST(ClosedLoop, SpeedStandoffPutsQdWhereTheLimitHoldsTheRobot) {
   EXPECT_LT(on.goal_step_rms_m, 0.5 * raw.goal_step_rms_m) << "the filter steadies q^d";
 }
 
-// The standoff and the path sample together (docs/EVALUATION.md, nineteenth session): random
+// The standoff and the path sample together (docs/eval/SESSIONS.md, nineteenth session): random
 // validation world 174, where a pedestrian walks at the robot across its way to q^d at ~9.5 s.
 // The costmap holds the pedestrian where they were seen, so each step the plan's best move is
 // away from them: with q^d at the standoff (no pull against the limit) the robot backs away with
@@ -830,7 +830,7 @@ TEST(ClosedLoop, TheObstacleSpeedLimitKeepsTheRobotOffTheDeadEndsWall) {
   // The dead end, seed 2, with q^d held behind the person (the fixed_behind baseline, as
   // companion-eval runs it): they turn back at the end and walk at the robot, which sidesteps to
   // get behind them and, its plan squeezed between their ellipse and the wall, drives its corner
-  // into the wall at 17.4 s (docs/EVALUATION.md, thirty-third session). obstacle_speed.* keeps
+  // into the wall at 17.4 s (docs/eval/SESSIONS.md, thirty-third session). obstacle_speed.* keeps
   // every command within what stops short of the wall.
   auto make = [](bool on) {
     SimRunOptions o;

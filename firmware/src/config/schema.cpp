@@ -392,7 +392,7 @@ std::vector<FieldSpec> build() {
        "to the field's distortion, and a sharp corner's first frames are far from the filter's "
        "rate). Measured with human.prediction_turn_time_constant_s 0.5 (a rate known at once and "
        "carried 2 s swings q^d far round the person): e_theta lower on every random table, but "
-       "more trials lost in crowds (docs/EVALUATION.md, thirty-ninth and fortieth sessions).",
+       "more trials lost in crowds (docs/eval/SESSIONS.md, thirty-ninth and fortieth sessions).",
        FIELD(human.use_gyro),
        0,
        0,
@@ -453,7 +453,7 @@ std::vector<FieldSpec> build() {
        "sooner than the point it is asked to be at: with the position's 2 s the robot overshoots "
        "the heading of every turn. Measured with 0.3: on gentle walks 49 of 50 against 47, e_theta "
        "0.088 against 0.096 rad; on sharp ones e_theta not lower, and 37 of 40 crowd trials "
-       "against 38 (docs/EVALUATION.md, forty-first session).",
+       "against 38 (docs/eval/SESSIONS.md, forty-first session).",
        FIELD(human.prediction_heading_turn_time_constant_s),
        0.0,
        60.0,
@@ -716,7 +716,7 @@ std::vector<FieldSpec> build() {
        "The farthest interactive_space.speed_standoff moves a point from the person. Beyond it "
        "the closing-speed limit holds the robot and its plan pulls toward q^d against the limit, "
        "as with the fixed ellipse: uncapped, a 1.7 m/s walker's point behind is ~1.8 m back, "
-       "at the 2 m loss rule's edge (docs/EVALUATION.md, twentieth session). 0: no cap.",
+       "at the 2 m loss rule's edge (docs/eval/SESSIONS.md, twentieth session). 0: no cap.",
        FIELD(interactive_space.speed_standoff_max_m),
        0.0,
        5.0,
@@ -798,7 +798,7 @@ std::vector<FieldSpec> build() {
        "switch_cost: added to G per index step (wrapped) between a candidate and the point chosen "
        "last; ours, the paper's action-smoothness reward r^a as a cost. 0: the paper's G. Above "
        "0, q^d stays where it is on a near tie rather than jumping round the person (an "
-       "experiment: docs/EVALUATION.md, twenty-fifth session).",
+       "experiment: docs/eval/SESSIONS.md, twenty-fifth session).",
        FIELD(objective.switch_cost),
        0.0,
        1000.0,
@@ -808,7 +808,7 @@ std::vector<FieldSpec> build() {
        "turn_inside: G of a candidate plus turn_inside * max(0, omega * y), omega the person's "
        "estimated turn rate (+ left), y how far the candidate is to their left (b sin phi_i): the "
        "inside of a sharp turn, where the turning person walks, costs more. Ours; 0: the paper's "
-       "G (an experiment: docs/EVALUATION.md, thirty-second session).",
+       "G (an experiment: docs/eval/SESSIONS.md, thirty-second session).",
        FIELD(objective.turn_inside),
        0.0,
        1000.0,
@@ -819,7 +819,7 @@ std::vector<FieldSpec> build() {
        "points only, at most this many points a second (ours; the paper's learned selector is "
        "trained for this with its action-smoothness reward r^a). 0: off, the argmin at once. "
        "Where neither way round W is free the argmin is taken at once (an experiment: "
-       "docs/EVALUATION.md, thirty-second session).",
+       "docs/eval/SESSIONS.md, thirty-second session).",
        FIELD(objective.slew_points_per_s),
        0.0,
        10000.0,
@@ -988,7 +988,7 @@ std::vector<FieldSpec> build() {
        "The plan's largest backward speed (not in the paper; Nav2's MPPI has vx_min): samples and "
        "mean reverse no faster (nor faster than limits.vx_max_mps). The barrier's repair and the "
        "closing-speed limit may still back off at limits.vx_max_mps to keep the person safe. "
-       "docs/EVALUATION.md, twenty-eighth session.",
+       "docs/eval/SESSIONS.md, twenty-eighth session.",
        FIELD(mppi.reverse_speed_max_mps),
        0.0,
        3.0,
@@ -997,7 +997,7 @@ std::vector<FieldSpec> build() {
        "1/s",
        "The structured samples' steering law: its pull toward q^d's heading (q^d's turn rate feeds "
        "forward besides). Those samples are the plan most of the time, so this sets how fast the "
-       "robot answers the person's turn. docs/EVALUATION.md, thirty-seventh session.",
+       "robot answers the person's turn. docs/eval/SESSIONS.md, thirty-seventh session.",
        FIELD(mppi.guide_heading_gain_per_s),
        0.5,
        20.0,

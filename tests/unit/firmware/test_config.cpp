@@ -225,7 +225,7 @@ TEST(Config, ControllerParametersComeFromTheConfigurationAsInThePaper) {
   EXPECT_DOUBLE_EQ(c.step_s, 0.1);
   EXPECT_EQ(c.samples, 2000);
   EXPECT_DOUBLE_EQ(c.lambda, 1.0);
-  // The paper's Q but the heading weight (60: docs/EVALUATION.md, twenty-third session).
+  // The paper's Q but the heading weight (60: docs/eval/SESSIONS.md, twenty-third session).
   EXPECT_EQ(c.q, (std::array<double, 3>{50.0, 10.0, 60.0}));
   EXPECT_EQ(c.tracking_frame, core::TrackingFrame::kGoal);
   EXPECT_DOUBLE_EQ(c.collision_cost, 1000.0);
@@ -238,7 +238,8 @@ TEST(Config, ControllerParametersComeFromTheConfigurationAsInThePaper) {
   const auto w = firmware::interactive_space_config(*firmware::load_default_config().config);
   EXPECT_EQ(w.points, 64);
   EXPECT_DOUBLE_EQ(w.cost_threshold, 30.0);
-  EXPECT_TRUE(w.speed_standoff) << "with mppi.path_guide (docs/EVALUATION.md, nineteenth session)";
+  EXPECT_TRUE(w.speed_standoff)
+      << "with mppi.path_guide (docs/eval/SESSIONS.md, nineteenth session)";
   EXPECT_TRUE(c.path_guide);
   EXPECT_DOUBLE_EQ(w.closing.robot_decel_mps2, c.closing.robot_decel_mps2) << "the limit's own";
   EXPECT_DOUBLE_EQ(w.closing.footprint.x_max_m, c.closing.footprint.x_max_m);

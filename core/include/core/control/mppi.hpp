@@ -65,7 +65,7 @@ struct MppiConfig {
   // and the closing-speed limit may still back the robot off up to limits.vx: they keep the
   // person safe. Among pedestrians walking at the robot, a plan free to reverse backs away from
   // them, and from the person, at full speed; a slower reverse leaves stepping aside the cheaper
-  // way (docs/EVALUATION.md, twenty-eighth session).
+  // way (docs/eval/SESSIONS.md, twenty-eighth session).
   double reverse_speed_max_mps = 3.0;
   // Speed and separation toward the person, applied to the repaired command (closing_speed.hpp;
   // robot_decel_mps2 = 0: off).
@@ -109,7 +109,7 @@ struct MppiConfig {
   // The steering law's pull toward q^d's heading (1/s; its turn rate feeds forward besides): 2
   // turns a 0.5 rad lag back at 1 rad/s. With the structured samples the plan most of the time
   // (~87 % of the control steps on the random worlds), this is how fast the robot answers a
-  // person's turn (docs/EVALUATION.md, thirty-seventh session).
+  // person's turn (docs/eval/SESSIONS.md, thirty-seventh session).
   double guide_heading_gain_per_s = 2.0;
   double orbit_radius = 1.15;
   double orbit_speed_mps = 1.0;

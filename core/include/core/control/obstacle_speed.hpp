@@ -18,7 +18,7 @@
 // Where an obstacle first appears inside the stopping distance, the acceleration limits after
 // this stage keep the command from dropping faster than the base can brake.
 // Why it exists: in the dead-end corridors the barrier's repair and the plan's sidestep round a
-// person walking back at the robot drove it into the corridor's wall (docs/EVALUATION.md,
+// person walking back at the robot drove it into the corridor's wall (docs/eval/SESSIONS.md,
 // thirty-third session). Obstacles are the costmap's cells that have held an obstacle for at
 // least `settled_s` (Costmap::obstacle_age_s): walls, furniture, a person standing. A walking
 // pedestrian's cells are younger (they leave each within a fraction of a second): taken as

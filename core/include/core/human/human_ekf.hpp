@@ -41,7 +41,7 @@ struct HumanEkfConfig {
   // How long the turn rate lasts in q^d's heading alone (0: as its position, the line above;
   // predict_goal_headings). A mecanum base turns without moving: the heading it is asked for over
   // the horizon can fade sooner than the carrier that places q^d and orients its error
-  // (docs/EVALUATION.md, forty-first session).
+  // (docs/eval/SESSIONS.md, forty-first session).
   double prediction_heading_turn_time_constant_s = 0.0;
 };
 

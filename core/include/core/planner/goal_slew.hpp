@@ -2,7 +2,7 @@
 // q^d moved round the ellipse at a bounded rate (ours, off by default). The objective argmin
 // jumps: when a pedestrian's band covers the point in use, the next choice may be the other side
 // of the person, and the tracking error e = q^d - q^r is that jump until the robot gets there
-// (three fifths of the random benchmark's e_x^2: docs/EVALUATION.md, twenty-ninth session). The
+// (three fifths of the random benchmark's e_x^2: docs/eval/SESSIONS.md, twenty-ninth session). The
 // paper's learned selector is trained against such jumps (its action-smoothness reward r^a); its
 // q^d "evolves smoothly". Here the point in use steps toward the argmin along W, through free
 // points only, at most `points_per_s`; where neither way round is free the argmin is taken at

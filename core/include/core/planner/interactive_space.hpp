@@ -37,7 +37,7 @@ struct InteractiveSpaceConfig {
   // Ours: G of a point plus turn_inside * max(0, omega * y^h_i), omega the person's turn rate
   // (rad/s, + left), y^h_i = b sin phi_i how far the point is to their left: the points on the
   // inside of a turn cost more the sharper it is. A robot there is where the turning person
-  // walks (docs/EVALUATION.md, twenty-fifth and thirtieth sessions). 0: the paper's G.
+  // walks (docs/eval/SESSIONS.md, twenty-fifth and thirtieth sessions). 0: the paper's G.
   double turn_inside = 0.0;
   // Ours: when true, a point of W nearer the person than the robot may follow them under the
   // closing-speed limit (follow_standoff_m with `closing`, at the person's velocity) is moved

@@ -64,7 +64,7 @@ struct RandomScenarioOptions {
   // so a smaller bound scales the same seed's turns down), walked on arcs no faster than
   // corner_turn_rate_radps; bounds below 90 degrees walk 2-4 m legs and are pulled toward the
   // middle, so that they turn round before the edge. The benchmark's walks: +-100 deg at 3 rad/s;
-  // the recorded pedestrians of sim/data/pedestrians turn far less (docs/EVALUATION.md,
+  // the recorded pedestrians of sim/data/pedestrians turn far less (docs/eval/SESSIONS.md,
   // thirty-seventh session: companion-eval's `turns-D` cases).
   double max_turn_rad = 1.75;
   double corner_turn_rate_radps = 3.0;

@@ -59,7 +59,7 @@ struct CornerLimits {
   // slows down into it and speeds up out of it this evenly (3 m/s^2: a brisk stop, the person's
   // acceleration the daemon's closing-speed rule assumes). 0: at once, as the walks of the
   // benchmark up to the twenty-first session (from 1.4 m/s to a near standstill in one 50 ms
-  // step, 10+ m/s^2, and back at the robot as fast: docs/EVALUATION.md, twenty-second session).
+  // step, 10+ m/s^2, and back at the robot as fast: docs/eval/SESSIONS.md, twenty-second session).
   double speed_change_accel_mps2 = 3.0;
 };
 // Sampled every `step_s`, starting at `start_s` (standing at the first waypoint until then).
