@@ -206,7 +206,8 @@ struct Fault {
   core::Reason reason;
 };
 
-void PrintTo(const Fault& f, std::ostream* os) {
+// gtest finds a test parameter's printer by this name.
+void PrintTo(const Fault& f, std::ostream* os) {  // NOLINT(readability-identifier-naming)
   *os << f.name;
 }
 

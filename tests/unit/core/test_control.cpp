@@ -161,8 +161,11 @@ core::Costmap wall_map(double y_min_m = -0.6, double y_max_m = 0.6, double top_x
   core::VoxelGrid g(gc);
   g.recentre(1.5, 0);
   std::vector<core::Ray> rays;
-  for (double y = y_min_m; y <= y_max_m; y += 0.02)
-    rays.push_back({{1.5, -3.0, 3.0}, {1.5, y, 0.5}});
+  // A ray every 2 cm from y_min_m to y_max_m, both ends included (an integer count: a summed
+  // double step would decide the last ray by its rounding).
+  const auto wall_rays = static_cast<int>(std::lround((y_max_m - y_min_m) / 0.02));
+  for (int k = 0; k <= wall_rays; ++k)
+    rays.push_back({{1.5, -3.0, 3.0}, {1.5, y_min_m + 0.02 * k, 0.5}});
   for (int k = 1; 1.5 + 0.02 * k <= top_x_end_m; ++k)
     rays.push_back({{1.5 + 0.02 * k, -3.0, 3.0}, {1.5 + 0.02 * k, y_max_m, 0.5}});
   g.insert(rays, Pose2{30, 30, 0}, std::nullopt, 1s);
