@@ -57,7 +57,9 @@ train:
 	./build/release/sim/companion-train --out $(TRAIN_OUT) --steps $(TRAIN_STEPS) --log $(TRAIN_OUT).csv $(TRAIN_ARGS)
 
 # Coverage-guided fuzzing of the decoders (clang + libFuzzer), FUZZ_SECONDS each, starting from
-# the seed corpora in tests/fuzz/corpus (copied: the repository is not modified).
+# the seed corpora in tests/fuzz/corpus (copied: the repository is not modified). A crash, leak or
+# out-of-memory input fails it, and so does a timeout that repeats when its input is run alone
+# (toolchain/fuzz_findings.sh: one that does not was the machine stalling); the input is kept.
 fuzz: deps
 	@cmake --preset fuzz > /dev/null
 	@cmake --build --preset fuzz -j $(JOBS) --target $(FUZZERS)
@@ -66,7 +68,7 @@ fuzz: deps
 	  echo "== fuzz $$f ($(FUZZ_SECONDS) s) =="; \
 	  build/fuzz/tests/fuzz/$$f -max_total_time=$(FUZZ_SECONDS) -timeout=10 -print_final_stats=0 \
 	    -artifact_prefix=$$work/ $$work/$$f 2>&1 | grep -E "DONE|ERROR|SUMMARY" || true; \
-	  if ls $$work/crash-* $$work/leak-* $$work/timeout-* > /dev/null 2>&1; then \
+	  if ! toolchain/fuzz_findings.sh build/fuzz/tests/fuzz/$$f $$work; then \
 	    echo "fuzz $$f: failing input kept in $$work"; exit 1; fi; \
 	done; rm -rf $$work
 
