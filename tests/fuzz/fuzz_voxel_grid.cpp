@@ -3,7 +3,8 @@
 // within 25 m of the robot, placed on a 1/64-cell lattice (so block faces and corners are hit
 // exactly) with optional nudges of 1e-9, 1e-12 m or one ulp (nearly parallel to a face). No
 // crash, no hang (`make fuzz` runs it with a per-input timeout: a ray along a block face once
-// looped for ever), and the grid stays within its window.
+// looped for ever, and one along a face past a block's corner again; corpus/along_face_past_corner
+// is that input), and the grid stays within its window.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>

@@ -185,6 +185,7 @@ void VoxelGrid::clear_ray(const Ray& r, int64_t end_cx, int64_t end_cy, int end_
     if (block_count_[static_cast<size_t>((sj >> kBlockShift) * blocks_per_row +
                                          (si >> kBlockShift))] == 0) {
       // Nothing to clear in this block: continue from where the ray leaves it.
+      const int64_t cx_in = cx, cy_in = cy;
       int64_t bx = cx >> kBlockShift;  // arithmetic shift: floor(cx / kBlock)
       int64_t by = cy >> kBlockShift;
       double t_exit = 0.0;
@@ -223,11 +224,17 @@ void VoxelGrid::clear_ray(const Ray& r, int64_t end_cx, int64_t end_cy, int end_
         bx = nbx;
         by = nby;
       }
-      t = t_exit;
+      // Never back along the ray: at a block's corner rounding can put its exit a hair before
+      // where it entered, and the cell computed there across a face it has already crossed.
+      // Stepping back there walked the same three blocks round a corner for ever (a hang of the
+      // lidar task, fuzz_voxel_grid): t and the cell only move the way the ray goes.
+      t = std::max(t, t_exit);
       const double qx = x0 + dx * (t + eps);
       const double qy = y0 + dy * (t + eps);
       cx = floor_to_int(qx * inv_res);
       cy = floor_to_int(qy * inv_res);
+      cx = sx > 0 ? std::max(cx, cx_in) : std::min(cx, cx_in);
+      cy = sy > 0 ? std::max(cy, cy_in) : std::min(cy, cy_in);
       if ((cx >> kBlockShift) == bx && (cy >> kBlockShift) == by) {
         // Still in the block it leaves: its move past the face (eps times its extent across it)
         // is below the rounding of its position (a ray along a block face, nearly parallel to

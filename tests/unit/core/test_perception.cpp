@@ -286,6 +286,21 @@ TEST(VoxelGrid, ARayAlongABlockFaceEndsAndClearsBeyondTheFace) {
   EXPECT_FALSE(g.occupied(obstacle.x, obstacle.y, obstacle.z));
 }
 
+// fuzz_voxel_grid's find: a ray along a block face (x = -200.8 m, 251 blocks from odom's
+// origin), 1e-12 m off it and nearly parallel, passing a block corner (y = 211.2 m). Rounding put
+// its exit from one block a hair before its entry, and the cell there across the face it had
+// crossed: it walked the same three blocks round the corner for ever (the lidar task hung).
+TEST(VoxelGrid, ARayAlongABlockFacePastACornerEnds) {
+  core::VoxelGridConfig c;  // the daemon's: 12 m at 5 cm, seen-through on
+  core::VoxelGrid g(c);
+  g.recentre(-200.8, 211.175);
+  const Ray along{{-200.79999999999902, 211.175, 0.488}, {-200.800000001, 236.185937499, 0.1}};
+  const Ray across{{-200.79999999999902, 211.175, 0.488}, {-199.3, 212.6, 0.6}};
+  g.insert(std::vector<Ray>{along, across}, core::Pose2{-200.8, 211.175, 0.0}, std::nullopt, 1s);
+  EXPECT_TRUE(g.occupied(across.end.x, across.end.y, across.end.z)) << "the scan was inserted";
+  EXPECT_EQ(g.stats().marked, 1U) << "the return within the window; the other ends beyond it";
+}
+
 // Ray clearing walks over runs of empty blocks without computing each entry cell; the grid it
 // leaves must equal, bit for bit, the one where every block is entered by the general
 // computation: random rays and obstacles (returns and beams without a return, windows rolled to
