@@ -26,7 +26,7 @@ core::VoxelGridConfig small_grid() {
   return c;
 }
 
-const Point3 kSensor{0.0, 0.0, 0.5};
+constexpr Point3 kSensor{0.0, 0.0, 0.5};
 
 Ray ray_to(double x, double y, double z, Point3 origin = kSensor) {
   return Ray{origin, Point3{x, y, z}};
@@ -379,6 +379,7 @@ TEST(VoxelGrid, MemoryDoesNotGrowAndDecayedVoxelsAreFreed) {
     const double x = 0.05 * scan;  // 0.5 m/s
     g.recentre(x, 0.0);
     std::vector<Ray> rays;
+    rays.reserve(500);
     for (int i = 0; i < 500; ++i) {
       rays.push_back(ray_to(x + u(rng), u(rng), h(rng), Point3{x, 0.0, 0.5}));
     }
@@ -403,7 +404,8 @@ TEST(VoxelGrid, AWalkingPersonLeavesNoTrail) {
   for (int scan = 0; scan <= 30; ++scan) {
     const double y = -1.5 + 0.1 * scan;  // 1 m/s at 10 Hz
     std::vector<Ray> rays;
-    for (double yy = -2.0; yy <= 2.0; yy += 0.02) {
+    for (int k = 0; k <= 200; ++k) {  // a ray every 2 cm, -2 to 2 m
+      const double yy = -2.0 + 0.02 * k;
       const bool blocked = std::abs(yy - y) < 0.15;
       rays.push_back(ray_to(blocked ? 2.0 : 3.5, blocked ? yy * 2.0 / 3.5 : yy, 0.5));
     }
