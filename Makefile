@@ -9,6 +9,8 @@ TSAN_TARGETS := test_core_channel test_hal_clock test_firmware_executor test_fir
 FUZZERS := fuzz_candump_line fuzz_slcan_stream fuzz_scout_decode fuzz_amfiprot fuzz_vlp16 \
   fuzz_pedestrian_dataset fuzz_voxel_grid
 FUZZ_SECONDS ?= 10
+# Per input: longer is a hang (a finding if it repeats when the input runs alone).
+FUZZ_TIMEOUT_S := 10
 
 deps:
 	@bash toolchain/install-deps.sh
@@ -66,9 +68,10 @@ fuzz: deps
 	@set -e; work=$$(mktemp -d); for f in $(FUZZERS); do \
 	  mkdir -p $$work/$$f && cp tests/fuzz/corpus/$$f/* $$work/$$f/; \
 	  echo "== fuzz $$f ($(FUZZ_SECONDS) s) =="; \
-	  build/fuzz/tests/fuzz/$$f -max_total_time=$(FUZZ_SECONDS) -timeout=10 -print_final_stats=0 \
-	    -artifact_prefix=$$work/ $$work/$$f 2>&1 | grep -E "DONE|ERROR|SUMMARY" || true; \
-	  if ! toolchain/fuzz_findings.sh build/fuzz/tests/fuzz/$$f $$work; then \
+	  build/fuzz/tests/fuzz/$$f -max_total_time=$(FUZZ_SECONDS) -timeout=$(FUZZ_TIMEOUT_S) \
+	    -print_final_stats=0 -artifact_prefix=$$work/ $$work/$$f 2>&1 \
+	    | grep -E "DONE|ERROR|SUMMARY" || true; \
+	  if ! toolchain/fuzz_findings.sh build/fuzz/tests/fuzz/$$f $$work $(FUZZ_TIMEOUT_S); then \
 	    echo "fuzz $$f: failing input kept in $$work"; exit 1; fi; \
 	done; rm -rf $$work
 

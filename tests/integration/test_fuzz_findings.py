@@ -12,10 +12,11 @@ import unittest
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCRIPT = os.path.join(HERE, "..", "..", "toolchain", "fuzz_findings.sh")
 
-# A stand-in for a libFuzzer binary run on one input (FUZZER -timeout=10 FILE): an input that
-# says "slow" times out again (libFuzzer's timeout exit code, 70), any other runs in time.
+# A stand-in for a libFuzzer binary run on one input (FUZZER -timeout=7 FILE: the limit given):
+# an input that says "slow" times out again (libFuzzer's timeout exit code, 70), any other runs
+# in time.
 FAKE_FUZZER = """#!/usr/bin/env bash
-[[ "$1" == "-timeout=10" ]] || exit 3
+[[ "$1" == "-timeout=7" ]] || exit 3
 if grep -q slow "$2"; then echo "ERROR: libFuzzer: timeout"; exit 70; fi
 exit 0
 """
@@ -39,7 +40,7 @@ class FuzzFindings(unittest.TestCase):
             f.write(text)
 
     def verdict(self):
-        r = subprocess.run(["bash", SCRIPT, self.fuzzer, self.dir], capture_output=True,
+        r = subprocess.run(["bash", SCRIPT, self.fuzzer, self.dir, "7"], capture_output=True,
                            text=True, check=False)
         return r.returncode, r.stdout
 
@@ -76,8 +77,9 @@ class FuzzFindings(unittest.TestCase):
         self.assertEqual(self.verdict(), (0, ""))
 
     def test_a_bad_call_is_a_usage_error(self):
-        for args in ([self.fuzzer], [os.path.join(self.tmp.name, "none"), self.dir],
-                     [self.fuzzer, os.path.join(self.tmp.name, "none")]):
+        none = os.path.join(self.tmp.name, "none")
+        for args in ([self.fuzzer, self.dir], [none, self.dir, "7"], [self.fuzzer, none, "7"],
+                     [self.fuzzer, self.dir, "0"], [self.fuzzer, self.dir, "ten"]):
             r = subprocess.run(["bash", SCRIPT] + args, capture_output=True, text=True,
                                check=False)
             self.assertEqual(r.returncode, 2, args)
